@@ -1,0 +1,216 @@
+// Options structs describe their own fields once; loading, validation and
+// documentation all walk that one description.
+//
+// Every module owns a plain `*Options` struct with in-class defaults (units in
+// the name or comment) and a member template
+//
+//   template <class Visitor> void VisitFields(Visitor&& v) {
+//     v("blind_range", blind_range_m, FieldSpec::AtLeast(0.0, "m", "points closer are dropped"));
+//     v("timestamp_unit", timestamp_unit, FieldSpec::Doc("unit of the per-point time field"));
+//     v("imu", imu);   // a nested options struct becomes a YAML section
+//   }
+//
+// and a `std::string Validate() const` that returns "" when valid and
+// otherwise a message naming the key (use ValidateFields() for the ranges and
+// add cross-field checks). Supported field types: bool, integral types,
+// float, double, std::string, Eigen::Vector3d, Eigen::Matrix3d (YAML: 9
+// numbers, row-major), std::vector<double>, std::vector<std::string>, enums
+// with an EnumTraits<E> specialisation, and nested options structs.
+//
+// Loading from YAML: config/config_file.h. Rendering as documented YAML:
+// config/dump_options.h.
+//
+// Default-constructed options are pure values: nothing here touches files.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace swarmlio::config {
+
+/// Range, unit and one-line documentation of one option field.
+struct FieldSpec {
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool min_exclusive = false;
+  const char* unit = "";
+  const char* doc = "";
+
+  static FieldSpec Doc(const char* doc, const char* unit = "") {
+    FieldSpec s;
+    s.unit = unit;
+    s.doc = doc;
+    return s;
+  }
+  static FieldSpec AtLeast(double lo, const char* unit, const char* doc) {
+    FieldSpec s = Doc(doc, unit);
+    s.min = lo;
+    return s;
+  }
+  static FieldSpec Positive(const char* unit, const char* doc) {
+    FieldSpec s = AtLeast(0.0, unit, doc);
+    s.min_exclusive = true;
+    return s;
+  }
+  static FieldSpec InRange(double lo, double hi, const char* unit, const char* doc) {
+    FieldSpec s = AtLeast(lo, unit, doc);
+    s.max = hi;
+    return s;
+  }
+  /// Copy with an upper bound, e.g. FieldSpec::Positive("Hz", "...").WithMax(1000).
+  FieldSpec WithMax(double hi) const {
+    FieldSpec s = *this;
+    s.max = hi;
+    return s;
+  }
+};
+
+/// Specialise for an enum used in options:
+///   template <> struct EnumTraits<TimestampUnit> {
+///     static constexpr std::array<std::pair<TimestampUnit, const char*>, 4> kNames{{...}};
+///   };
+template <class E>
+struct EnumTraits;
+
+template <class E, class = void>
+struct HasEnumTraits : std::false_type {};
+template <class E>
+struct HasEnumTraits<E, std::void_t<decltype(EnumTraits<E>::kNames)>> : std::true_type {};
+
+template <class E>
+const char* EnumToString(E value) {
+  for (const auto& [v, name] : EnumTraits<E>::kNames) {
+    if (v == value) return name;
+  }
+  return "?";
+}
+
+template <class E>
+bool EnumFromString(const std::string& text, E* value) {
+  for (const auto& [v, name] : EnumTraits<E>::kNames) {
+    if (text == name) {
+      *value = v;
+      return true;
+    }
+  }
+  return false;
+}
+
+template <class E>
+std::string EnumChoices() {
+  std::string out;
+  for (const auto& [v, name] : EnumTraits<E>::kNames) {
+    (void)v;
+    if (!out.empty()) out += ", ";
+    out += name;
+  }
+  return out;
+}
+
+/// True for option structs (they have a VisitFields member template).
+template <class T, class = void>
+struct IsOptionsStruct : std::false_type {};
+struct NullVisitor {
+  template <class... A>
+  void operator()(A&&...) {}
+};
+template <class T>
+struct IsOptionsStruct<T, std::void_t<decltype(std::declval<T&>().VisitFields(NullVisitor{}))>>
+    : std::true_type {};
+
+namespace internal {
+
+inline std::string FormatRange(const FieldSpec& spec) {
+  std::ostringstream os;
+  const bool has_min = std::isfinite(spec.min);
+  const bool has_max = std::isfinite(spec.max);
+  if (has_min && has_max) {
+    os << "in " << (spec.min_exclusive ? "(" : "[") << spec.min << ", " << spec.max << "]";
+  } else if (has_min) {
+    os << (spec.min_exclusive ? "> " : ">= ") << spec.min;
+  } else if (has_max) {
+    os << "<= " << spec.max;
+  }
+  if (spec.unit[0] != '\0') os << " " << spec.unit;
+  return os.str();
+}
+
+inline bool InRange(double value, const FieldSpec& spec) {
+  if (!std::isfinite(value)) return false;
+  if (spec.min_exclusive ? !(value > spec.min) : !(value >= spec.min)) return false;
+  return value <= spec.max;
+}
+
+/// Checks one scalar against its spec; returns "" or "key: reason".
+inline std::string CheckScalar(const std::string& key, double value, const FieldSpec& spec) {
+  if (InRange(value, spec)) return {};
+  std::ostringstream os;
+  os << key << ": value " << value << " is out of range (must be ";
+  const std::string range = FormatRange(spec);
+  os << (range.empty() ? "finite" : range) << ")";
+  return os.str();
+}
+
+/// Visitor that collects the first range violation.
+class RangeChecker {
+ public:
+  explicit RangeChecker(std::string prefix) : prefix_(std::move(prefix)) {}
+
+  template <class T>
+  void operator()(const char* key, T& field, const FieldSpec& spec = FieldSpec()) {
+    if (!error_.empty()) return;
+    const std::string full = prefix_.empty() ? key : prefix_ + "." + key;
+    if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::string> ||
+                  std::is_same_v<T, std::vector<std::string>> || std::is_enum_v<T>) {
+      (void)field;
+      (void)spec;
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      error_ = CheckScalar(full, static_cast<double>(field), spec);
+    } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+      for (int i = 0; i < 3 && error_.empty(); ++i) {
+        error_ = CheckScalar(full + "[" + std::to_string(i) + "]", field[i], spec);
+      }
+    } else if constexpr (std::is_same_v<T, Eigen::Matrix3d>) {
+      for (int i = 0; i < 9 && error_.empty(); ++i) {  // row-major index, as in YAML
+        error_ = CheckScalar(full + "[" + std::to_string(i) + "]", field(i / 3, i % 3), spec);
+      }
+    } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+      for (size_t i = 0; i < field.size() && error_.empty(); ++i) {
+        error_ = CheckScalar(full + "[" + std::to_string(i) + "]", field[i], spec);
+      }
+    } else if constexpr (IsOptionsStruct<T>::value) {
+      (void)spec;
+      error_ = field.Validate();
+      if (!error_.empty()) error_ = full + "." + error_;
+    } else {
+      static_assert(sizeof(T) == 0, "unsupported option field type");
+    }
+  }
+
+  const std::string& error() const { return error_; }
+
+ private:
+  std::string prefix_;
+  std::string error_;
+};
+
+}  // namespace internal
+
+/// Checks every field of `options` against its FieldSpec (and nested
+/// structs through their own Validate()). Returns "" or "key: reason".
+template <class Options>
+std::string ValidateFields(const Options& options) {
+  Options copy = options;
+  internal::RangeChecker checker("");
+  copy.VisitFields(checker);
+  return checker.error();
+}
+
+}  // namespace swarmlio::config
