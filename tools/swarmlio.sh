@@ -72,9 +72,17 @@ case "$cmd" in
     setup
     ;;
   demo)
+    # Main job until the estimator lands: simulate the default scenario
+    # (indoor_3uav: 3 drones, 60 s), then read every drone's bag back with the
+    # streaming reader and print its contents and reader statistics.
     setup
-    shift
-    "$BUILD_DIR/tools/demo/swarmlio_demo" "$@"
+    out="${DEMO_OUT:-$ROOT/results/demo}"
+    log "simulating configs/scenarios/indoor_3uav.yaml into $out"
+    "$BUILD_DIR/tools/sim/swarmlio_sim" --scenario "$ROOT/configs/scenarios/indoor_3uav.yaml" \
+      --output_dir "$out" "${@:2}"
+    for bag in "$out"/*.bag; do
+      "$BUILD_DIR/tools/bag/swarmlio_bag_info" "$bag"
+    done
     ;;
   test)
     setup

@@ -8,6 +8,7 @@
 //     v("blind_range", blind_range_m, FieldSpec::AtLeast(0.0, "m", "points closer are dropped"));
 //     v("timestamp_unit", timestamp_unit, FieldSpec::Doc("unit of the per-point time field"));
 //     v("imu", imu);   // a nested options struct becomes a YAML section
+//     v("drones", drones);  // std::vector<DroneOptions>: a YAML list of sections
 //   }
 //
 // and a `std::string Validate() const` that returns "" when valid and
@@ -15,7 +16,18 @@
 // add cross-field checks). Supported field types: bool, integral types,
 // float, double, std::string, Eigen::Vector3d, Eigen::Matrix3d (YAML: 9
 // numbers, row-major), std::vector<double>, std::vector<std::string>, enums
-// with an EnumTraits<E> specialisation, and nested options structs.
+// with an EnumTraits<E> specialisation, nested options structs, and
+// std::vector of an options struct (a YAML sequence of maps; each element
+// starts from a default-constructed struct and is validated on its own; keys
+// in messages carry the index, "drones[2].lidar.blind_range_m").
+//
+// A struct that extends another one with more keys at the same YAML level
+// holds it as a member and visits it inline:
+//
+//   template <class Visitor> void VisitFields(Visitor&& v) {
+//     sensor.VisitFields(v);   // the shared keys, unprefixed
+//     v("dropout_probability", dropout_probability, FieldSpec::InRange(0, 1, "", "..."));
+//   }
 //
 // Loading from YAML: config/config_file.h. Rendering as documented YAML:
 // config/dump_options.h.
@@ -125,7 +137,24 @@ template <class T>
 struct IsOptionsStruct<T, std::void_t<decltype(std::declval<T&>().VisitFields(NullVisitor{}))>>
     : std::true_type {};
 
+/// True for std::vector<T> with T an options struct (a YAML list of sections).
+template <class T>
+struct IsOptionsList : std::false_type {};
+template <class T, class A>
+struct IsOptionsList<std::vector<T, A>> : IsOptionsStruct<T> {};
+
+/// "key[i]": the key of element `i` of a list, as messages and key paths
+/// (ConfigFile::Read, KeyError) spell it.
+inline std::string IndexKey(const std::string& key, size_t i) {
+  return key + "[" + std::to_string(i) + "]";
+}
+
 namespace internal {
+
+/// Prefixes a Validate() message ("key: reason") with `prefix` + ".".
+inline std::string PrefixError(const std::string& prefix, const std::string& error) {
+  return error.empty() ? error : prefix + "." + error;
+}
 
 inline std::string FormatRange(const FieldSpec& spec) {
   std::ostringstream os;
@@ -175,20 +204,24 @@ class RangeChecker {
       error_ = CheckScalar(full, static_cast<double>(field), spec);
     } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
       for (int i = 0; i < 3 && error_.empty(); ++i) {
-        error_ = CheckScalar(full + "[" + std::to_string(i) + "]", field[i], spec);
+        error_ = CheckScalar(IndexKey(full, i), field[i], spec);
       }
     } else if constexpr (std::is_same_v<T, Eigen::Matrix3d>) {
       for (int i = 0; i < 9 && error_.empty(); ++i) {  // row-major index, as in YAML
-        error_ = CheckScalar(full + "[" + std::to_string(i) + "]", field(i / 3, i % 3), spec);
+        error_ = CheckScalar(IndexKey(full, i), field(i / 3, i % 3), spec);
       }
     } else if constexpr (std::is_same_v<T, std::vector<double>>) {
       for (size_t i = 0; i < field.size() && error_.empty(); ++i) {
-        error_ = CheckScalar(full + "[" + std::to_string(i) + "]", field[i], spec);
+        error_ = CheckScalar(IndexKey(full, i), field[i], spec);
       }
     } else if constexpr (IsOptionsStruct<T>::value) {
       (void)spec;
-      error_ = field.Validate();
-      if (!error_.empty()) error_ = full + "." + error_;
+      error_ = PrefixError(full, field.Validate());
+    } else if constexpr (IsOptionsList<T>::value) {
+      (void)spec;
+      for (size_t i = 0; i < field.size() && error_.empty(); ++i) {
+        error_ = PrefixError(IndexKey(full, i), field[i].Validate());
+      }
     } else {
       static_assert(sizeof(T) == 0, "unsupported option field type");
     }

@@ -1,0 +1,80 @@
+// LiDAR measurement model: casts each pulse from the sensor pose at the
+// pulse's own time against the static scene and against every other moving
+// object (teammates, decoys) at that same time.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "swarmlio/sim/drone_body.h"
+#include "swarmlio/sim/lidar_options.h"
+#include "swarmlio/sim/lidar_pattern.h"
+#include "swarmlio/sim/scene.h"
+#include "swarmlio/sim/trajectory.h"
+
+namespace swarmlio::sim {
+
+/// One return, with ground truth.
+struct SimulatedPoint {
+  double t_s = 0.0;                                       // true time of the pulse [s]
+  Eigen::Vector3d p_in_lidar = Eigen::Vector3d::Zero();   // measured (with range noise) [m]
+  double true_range_m = 0.0;
+  double reflectivity = 0.0;                              // Livox 0-255 scale
+  uint8_t line = 0;
+  int object = -1;      // -1: static scene; else the index of the moving object hit
+  int primitive = -1;   // index into the scene's or the object's primitives
+};
+
+struct SimulatedScan {
+  int64_t frame_index = 0;
+  double start_time_s = 0.0;  // true time of the first pulse
+  double period_s = 0.0;      // 1 / frame rate
+  int64_t num_pulses = 0;     // pulses fired (returns + misses + dropouts)
+  std::vector<SimulatedPoint> points;  // in firing (time) order
+};
+
+class LidarModel {
+ public:
+  /// All pointers must outlive the model. `own_object` is the index of the
+  /// carrying drone in `objects` (never seen by its own sensor), or -1. The
+  /// first pulse of frame 0 fires at true time options.start_time_s.
+  LidarModel(const SimulatedLidarOptions& options, const Trajectory* own_trajectory,
+             const Scene* scene, const std::vector<MovingObject>* objects, int own_object,
+             uint64_t seed);
+
+  double FrameStart(int64_t frame) const { return t0_ + static_cast<double>(frame) * period_; }
+  double period() const { return period_; }
+  int64_t pulses_per_frame() const { return pattern_.pulses_per_frame(); }
+  /// R_imu_lidar of the options projected onto SO(3) (the rotation used).
+  const Eigen::Matrix3d& R_imu_lidar() const { return R_imu_lidar_; }
+
+  /// Pose of the LiDAR frame in W at time t: R_W_l, p_l_in_W.
+  Pose LidarPoseAt(double t) const;
+
+  /// Simulates frame `frame` into *scan (frames are independent of each other
+  /// except for the random stream: call them in order for reproducible noise).
+  void Scan(int64_t frame, SimulatedScan* scan);
+
+ private:
+  struct Candidate {
+    int object;
+    Eigen::Vector3d center;
+    double radius;
+  };
+
+  SimulatedLidarOptions options_;
+  LidarPattern pattern_;
+  const Trajectory* own_trajectory_;
+  const Scene* scene_;
+  const std::vector<MovingObject>* objects_;
+  int own_object_;
+  double t0_;
+  double period_;
+  Eigen::Matrix3d R_imu_lidar_;
+  std::mt19937_64 rng_;
+  std::vector<Candidate> candidates_;
+};
+
+}  // namespace swarmlio::sim

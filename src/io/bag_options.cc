@@ -1,0 +1,61 @@
+#include "swarmlio/io/bag_options.h"
+
+namespace swarmlio::io {
+namespace {
+
+const char* const kWrittenFieldNames[] = {"x", "y", "z", "intensity", "tag", "line"};
+
+std::string CheckTopic(const char* key, const std::string& topic, bool required) {
+  if (required && topic.empty()) return std::string(key) + ": must not be empty";
+  return {};
+}
+
+}  // namespace
+
+double TicksPerSecond(PointTimeUnit unit) {
+  switch (unit) {
+    case PointTimeUnit::kSecond:
+      return 1.0;
+    case PointTimeUnit::kMillisecond:
+      return 1e3;
+    case PointTimeUnit::kMicrosecond:
+      return 1e6;
+    case PointTimeUnit::kNanosecond:
+      return 1e9;
+  }
+  return 1.0;
+}
+
+std::string BagReaderOptions::Validate() const {
+  std::string error = config::ValidateFields(*this);
+  if (error.empty()) error = CheckTopic("imu_topic", imu_topic, true);
+  if (error.empty()) error = CheckTopic("lidar_topic", lidar_topic, true);
+  if (error.empty()) error = CheckTopic("ground_truth_topic", ground_truth_topic, false);
+  if (error.empty() && imu_topic == lidar_topic) {
+    error = "lidar_topic: must differ from imu_topic '" + imu_topic + "'";
+  }
+  if (error.empty() && (ground_truth_topic == imu_topic || ground_truth_topic == lidar_topic)) {
+    error = "ground_truth_topic: must differ from imu_topic and lidar_topic";
+  }
+  return error;
+}
+
+std::string BagWriterOptions::Validate() const {
+  std::string error = config::ValidateFields(*this);
+  if (error.empty()) error = CheckTopic("imu_topic", imu_topic, true);
+  if (error.empty()) error = CheckTopic("lidar_topic", lidar_topic, true);
+  if (error.empty()) error = CheckTopic("ground_truth_topic", ground_truth_topic, true);
+  if (error.empty() && (imu_topic == lidar_topic || imu_topic == ground_truth_topic ||
+                        lidar_topic == ground_truth_topic)) {
+    error = "imu_topic, lidar_topic, ground_truth_topic: must be distinct";
+  }
+  if (error.empty() && point_time_field.empty()) error = "point_time_field: must not be empty";
+  for (const char* name : kWrittenFieldNames) {
+    if (error.empty() && point_time_field == name) {
+      error = "point_time_field: '" + point_time_field + "' clashes with a written point field";
+    }
+  }
+  return error;
+}
+
+}  // namespace swarmlio::io

@@ -1,0 +1,20 @@
+// Decoding of the std_msgs/Header that starts every stamped message.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "src/io/wire_reader.h"
+#include "swarmlio/common/status.h"
+
+namespace swarmlio::io::internal {
+
+/// ROS time (sec, nsec) as integer nanoseconds.
+inline int64_t StampNsFromRos(uint32_t sec, uint32_t nsec) {
+  return static_cast<int64_t>(sec) * 1000000000LL + static_cast<int64_t>(nsec);
+}
+
+/// Reads std_msgs/Header (uint32 seq, time stamp, string frame_id).
+Status ReadRosHeader(WireReader* reader, int64_t* stamp_ns, std::string* frame_id);
+
+}  // namespace swarmlio::io::internal

@@ -1,0 +1,311 @@
+#include "src/io/pointcloud2_codec.h"
+
+#include <sensor_msgs/PointField.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <initializer_list>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "src/io/header_codec.h"
+#include "src/io/ros_time.h"
+#include "src/io/wire_reader.h"
+
+namespace swarmlio::io::internal {
+namespace {
+
+// Smallest serialized PointField: empty name (4) + offset (4) + datatype (1)
+// + count (4).
+constexpr size_t kMinPointFieldBytes = 13;
+
+struct WireField {
+  std::string name;
+  uint32_t offset = 0;
+  uint8_t datatype = 0;
+  uint32_t count = 0;
+};
+
+// Size in bytes of a PointField datatype, 0 for an unknown code.
+size_t DatatypeBytes(uint8_t datatype) {
+  switch (datatype) {
+    case sensor_msgs::PointField::INT8:
+    case sensor_msgs::PointField::UINT8:
+      return 1;
+    case sensor_msgs::PointField::INT16:
+    case sensor_msgs::PointField::UINT16:
+      return 2;
+    case sensor_msgs::PointField::INT32:
+    case sensor_msgs::PointField::UINT32:
+    case sensor_msgs::PointField::FLOAT32:
+      return 4;
+    case sensor_msgs::PointField::FLOAT64:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+// Where a used field sits inside a point.
+struct FieldAccessor {
+  bool present = false;
+  uint32_t offset = 0;
+  uint8_t datatype = 0;
+};
+
+double LoadAsDouble(const uint8_t* point, const FieldAccessor& field) {
+  const uint8_t* p = point + field.offset;
+  switch (field.datatype) {
+    case sensor_msgs::PointField::INT8:
+      return static_cast<int8_t>(p[0]);
+    case sensor_msgs::PointField::UINT8:
+      return p[0];
+    case sensor_msgs::PointField::INT16:
+      return static_cast<int16_t>(LoadLittleEndian<uint16_t>(p));
+    case sensor_msgs::PointField::UINT16:
+      return LoadLittleEndian<uint16_t>(p);
+    case sensor_msgs::PointField::INT32:
+      return static_cast<int32_t>(LoadLittleEndian<uint32_t>(p));
+    case sensor_msgs::PointField::UINT32:
+      return LoadLittleEndian<uint32_t>(p);
+    case sensor_msgs::PointField::FLOAT32:
+      return LoadFloat32(p);
+    case sensor_msgs::PointField::FLOAT64:
+      return LoadFloat64(p);
+    default:
+      return 0.0;  // unreachable: datatypes are validated before use
+  }
+}
+
+float LoadAsFloat(const uint8_t* point, const FieldAccessor& field) {
+  if (field.datatype == sensor_msgs::PointField::FLOAT32) {
+    return LoadFloat32(point + field.offset);
+  }
+  return static_cast<float>(LoadAsDouble(point, field));
+}
+
+uint8_t LoadAsByte(const uint8_t* point, const FieldAccessor& field) {
+  const double value = LoadAsDouble(point, field);
+  if (!(value > 0.0)) return 0;  // also NaN
+  if (value >= 255.0) return 255;
+  return static_cast<uint8_t>(value);
+}
+
+std::string FieldNames(const std::vector<WireField>& fields) {
+  std::string names;
+  for (const WireField& f : fields) {
+    if (!names.empty()) names += ", ";
+    names += f.name;
+  }
+  return "[" + names + "]";
+}
+
+const WireField* FindField(const std::vector<WireField>& fields, const std::string& name) {
+  for (const WireField& f : fields) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
+// Resolves the first of `names` present in `fields` and checks that it fits
+// inside a point of `point_step` bytes.
+Status ResolveField(const std::vector<WireField>& fields,
+                    std::initializer_list<const char*> names,
+                    uint32_t point_step,
+                    FieldAccessor* accessor,
+                    std::string* resolved_name = nullptr) {
+  *accessor = FieldAccessor();
+  for (const char* name : names) {
+    const WireField* f = FindField(fields, name);
+    if (f == nullptr) continue;
+    const size_t bytes = DatatypeBytes(f->datatype);
+    if (bytes == 0) {
+      return Status::DataLoss(std::string("PointCloud2 field '") + name +
+                              "' has unknown datatype " + std::to_string(f->datatype));
+    }
+    if (f->count == 0) {
+      return Status::DataLoss(std::string("PointCloud2 field '") + name + "' has count 0");
+    }
+    if (static_cast<uint64_t>(f->offset) + bytes > point_step) {
+      return Status::DataLoss(std::string("PointCloud2 field '") + name + "' (offset " +
+                              std::to_string(f->offset) + ", " + std::to_string(bytes) +
+                              " bytes) does not fit in point_step " + std::to_string(point_step));
+    }
+    accessor->present = true;
+    accessor->offset = f->offset;
+    accessor->datatype = f->datatype;
+    if (resolved_name != nullptr) *resolved_name = name;
+    return Status::Ok();
+  }
+  return Status::Ok();
+}
+
+template <class T>
+void Store(uint8_t* dst, T value) {
+  // PointCloud2 data is little endian (is_bigendian = false); so is the host
+  // (checked in EncodePointCloud2).
+  std::memcpy(dst, &value, sizeof(T));
+}
+
+sensor_msgs::PointField MakeField(const std::string& name, uint32_t offset, uint8_t datatype) {
+  sensor_msgs::PointField field;
+  field.name = name;
+  field.offset = offset;
+  field.datatype = datatype;
+  field.count = 1;
+  return field;
+}
+
+}  // namespace
+
+Status DecodePointCloud2(const uint8_t* data,
+                         size_t size,
+                         const PointCloud2DecodeOptions& options,
+                         LidarScan* scan,
+                         PointCloud2DecodeInfo* info) {
+  WireReader reader(data, size);
+  SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &scan->stamp_ns, &scan->frame_id));
+  scan->livox_timebase_ns = 0;
+  scan->livox_lidar_id = 0;
+  uint32_t height = 0;
+  uint32_t width = 0;
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadU32("height", &height));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadU32("width", &width));
+  uint32_t num_fields = 0;
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadArrayLength("fields", kMinPointFieldBytes, &num_fields));
+  std::vector<WireField> fields(num_fields);
+  for (WireField& f : fields) {
+    SWARMLIO_RETURN_IF_ERROR(reader.ReadString("fields.name", &f.name));
+    SWARMLIO_RETURN_IF_ERROR(reader.ReadU32("fields.offset", &f.offset));
+    SWARMLIO_RETURN_IF_ERROR(reader.ReadU8("fields.datatype", &f.datatype));
+    SWARMLIO_RETURN_IF_ERROR(reader.ReadU32("fields.count", &f.count));
+  }
+  uint8_t is_bigendian = 0;
+  uint32_t point_step = 0;
+  uint32_t row_step = 0;
+  uint32_t data_bytes = 0;
+  const uint8_t* cloud = nullptr;
+  uint8_t is_dense = 0;
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadU8("is_bigendian", &is_bigendian));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadU32("point_step", &point_step));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadU32("row_step", &row_step));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadArrayLength("data", 1, &data_bytes));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("data", data_bytes, &cloud));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadU8("is_dense", &is_dense));
+  SWARMLIO_RETURN_IF_ERROR(reader.ExpectEnd("sensor_msgs/PointCloud2"));
+
+  if (is_bigendian != 0) {
+    return Status::InvalidArgument("big-endian PointCloud2 (is_bigendian = true) is not supported");
+  }
+
+  FieldAccessor x, y, z, intensity, tag, line, time;
+  SWARMLIO_RETURN_IF_ERROR(ResolveField(fields, {"x"}, point_step, &x));
+  SWARMLIO_RETURN_IF_ERROR(ResolveField(fields, {"y"}, point_step, &y));
+  SWARMLIO_RETURN_IF_ERROR(ResolveField(fields, {"z"}, point_step, &z));
+  if (!x.present || !y.present || !z.present) {
+    return Status::InvalidArgument("PointCloud2 lacks an x, y or z field; fields are " +
+                                   FieldNames(fields));
+  }
+  SWARMLIO_RETURN_IF_ERROR(
+      ResolveField(fields, {"intensity", "reflectivity"}, point_step, &intensity));
+  SWARMLIO_RETURN_IF_ERROR(ResolveField(fields, {"tag"}, point_step, &tag));
+  SWARMLIO_RETURN_IF_ERROR(ResolveField(fields, {"line", "ring"}, point_step, &line));
+  info->time_field.clear();
+  if (options.time_field.empty()) {
+    SWARMLIO_RETURN_IF_ERROR(ResolveField(fields, {"time", "t", "timestamp", "offset_time"},
+                                          point_step, &time, &info->time_field));
+  } else {
+    SWARMLIO_RETURN_IF_ERROR(
+        ResolveField(fields, {options.time_field.c_str()}, point_step, &time, &info->time_field));
+    if (!time.present) {
+      return Status::InvalidArgument("PointCloud2 has no configured point time field '" +
+                                     options.time_field + "'; fields are " + FieldNames(fields));
+    }
+  }
+  info->has_time_field = time.present;
+
+  scan->points.clear();
+  const uint64_t num_points = static_cast<uint64_t>(width) * height;
+  if (num_points == 0) return Status::Ok();
+  const uint64_t row_bytes = static_cast<uint64_t>(width) * point_step;
+  if (row_step < row_bytes) {
+    return Status::DataLoss("PointCloud2 row_step " + std::to_string(row_step) +
+                            " < width * point_step " + std::to_string(row_bytes));
+  }
+  const uint64_t needed = static_cast<uint64_t>(height - 1) * row_step + row_bytes;
+  if (needed > data_bytes) {
+    return Status::DataLoss("PointCloud2 " + std::to_string(width) + "x" + std::to_string(height) +
+                            " points need " + std::to_string(needed) + " data bytes, message has " +
+                            std::to_string(data_bytes));
+  }
+
+  const double ticks_per_s = TicksPerSecond(options.time_unit);
+  scan->points.resize(num_points);
+  size_t index = 0;
+  for (uint32_t row = 0; row < height; ++row) {
+    const uint8_t* row_data = cloud + static_cast<uint64_t>(row) * row_step;
+    for (uint32_t col = 0; col < width; ++col) {
+      const uint8_t* p = row_data + static_cast<uint64_t>(col) * point_step;
+      LidarPoint& point = scan->points[index++];
+      point.x = LoadAsFloat(p, x);
+      point.y = LoadAsFloat(p, y);
+      point.z = LoadAsFloat(p, z);
+      point.reflectivity = intensity.present ? LoadAsFloat(p, intensity) : 0.f;
+      point.tag = tag.present ? LoadAsByte(p, tag) : 0;
+      point.line = line.present ? LoadAsByte(p, line) : 0;
+      point.offset_time_s = time.present ? LoadAsDouble(p, time) / ticks_per_s : 0.0;
+    }
+  }
+  return Status::Ok();
+}
+
+Status EncodePointCloud2(const LidarScan& scan,
+                         uint32_t seq,
+                         PointTimeUnit time_unit,
+                         const std::string& time_field,
+                         sensor_msgs::PointCloud2* msg) {
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "little-endian host required");
+  constexpr uint32_t kPointStep = 32;
+  if (scan.points.size() > std::numeric_limits<uint32_t>::max() / kPointStep) {
+    return Status::InvalidArgument("scan has too many points for one PointCloud2");
+  }
+  *msg = sensor_msgs::PointCloud2();
+  msg->header.seq = seq;
+  SWARMLIO_RETURN_IF_ERROR(RosTimeFromStampNs(scan.stamp_ns, &msg->header.stamp));
+  msg->header.frame_id = scan.frame_id;
+  using sensor_msgs::PointField;
+  msg->fields = {MakeField("x", 0, PointField::FLOAT32),
+                 MakeField("y", 4, PointField::FLOAT32),
+                 MakeField("z", 8, PointField::FLOAT32),
+                 MakeField("intensity", 12, PointField::FLOAT32),
+                 MakeField(time_field, 16, PointField::FLOAT64),
+                 MakeField("tag", 24, PointField::UINT8),
+                 MakeField("line", 25, PointField::UINT8)};
+  const uint32_t n = static_cast<uint32_t>(scan.points.size());
+  msg->height = 1;
+  msg->width = n;
+  msg->is_bigendian = false;
+  msg->point_step = kPointStep;
+  msg->row_step = kPointStep * n;
+  msg->data.assign(static_cast<size_t>(msg->row_step), 0);
+  const double ticks_per_s = TicksPerSecond(time_unit);
+  bool dense = true;
+  for (uint32_t i = 0; i < n; ++i) {
+    const LidarPoint& point = scan.points[i];
+    uint8_t* p = msg->data.data() + static_cast<size_t>(i) * kPointStep;
+    Store(p + 0, point.x);
+    Store(p + 4, point.y);
+    Store(p + 8, point.z);
+    Store(p + 12, point.reflectivity);
+    Store(p + 16, point.offset_time_s * ticks_per_s);
+    p[24] = point.tag;
+    p[25] = point.line;
+    dense = dense && std::isfinite(point.x) && std::isfinite(point.y) && std::isfinite(point.z);
+  }
+  msg->is_dense = dense;
+  return Status::Ok();
+}
+
+}  // namespace swarmlio::io::internal

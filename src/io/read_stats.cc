@@ -1,0 +1,50 @@
+#include "swarmlio/io/read_stats.h"
+
+#include <sstream>
+
+namespace swarmlio::io {
+
+const char* SkipReasonName(SkipReason reason) {
+  switch (reason) {
+    case SkipReason::kImuNonFinite:
+      return "imu_non_finite";
+    case SkipReason::kImuNonMonotonic:
+      return "imu_non_monotonic";
+    case SkipReason::kPointNonFinite:
+      return "point_non_finite";
+    case SkipReason::kScanEmpty:
+      return "scan_empty";
+    case SkipReason::kScanNonMonotonic:
+      return "scan_non_monotonic";
+    case SkipReason::kPoseNonFinite:
+      return "pose_non_finite";
+    case SkipReason::kPoseNonMonotonic:
+      return "pose_non_monotonic";
+    case SkipReason::kMalformedMessage:
+      return "malformed_message";
+    case SkipReason::kNumReasons:
+      break;
+  }
+  return "?";
+}
+
+int64_t ReadStats::TotalSkipped() const {
+  int64_t total = 0;
+  for (int64_t count : skipped) total += count;
+  return total;
+}
+
+std::string ReadStats::ToString() const {
+  std::ostringstream os;
+  os << "imu_samples: " << imu_samples << "\n"
+     << "scans: " << scans << "\n"
+     << "points: " << points << "\n"
+     << "ground_truth_poses: " << ground_truth_poses << "\n"
+     << "scans_without_point_time: " << scans_without_point_time << "\n";
+  for (size_t i = 0; i < kNumSkipReasons; ++i) {
+    os << "skipped." << SkipReasonName(static_cast<SkipReason>(i)) << ": " << skipped[i] << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace swarmlio::io

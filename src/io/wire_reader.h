@@ -1,0 +1,133 @@
+// Bounds-checked reader of ROS1-serialized message bytes (little endian).
+//
+// Every read checks the remaining byte count first; an array or string length
+// read from the wire is checked against the remaining bytes before anything
+// is allocated, so a corrupt length can neither overrun the buffer nor trigger
+// a huge allocation. Errors are DataLoss Status values naming the field.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+
+#include "swarmlio/common/status.h"
+
+namespace swarmlio::io::internal {
+
+/// Loads an unsigned little-endian integer from `bytes` (no alignment needed).
+template <class UInt>
+UInt LoadLittleEndian(const uint8_t* bytes) {
+  UInt value = 0;
+  for (size_t i = 0; i < sizeof(UInt); ++i) {
+    value = static_cast<UInt>(value | (static_cast<UInt>(bytes[i]) << (8 * i)));
+  }
+  return value;
+}
+
+inline float LoadFloat32(const uint8_t* bytes) {
+  const uint32_t bits = LoadLittleEndian<uint32_t>(bytes);
+  float value;
+  std::memcpy(&value, &bits, sizeof(value));
+  return value;
+}
+
+inline double LoadFloat64(const uint8_t* bytes) {
+  const uint64_t bits = LoadLittleEndian<uint64_t>(bytes);
+  double value;
+  std::memcpy(&value, &bits, sizeof(value));
+  return value;
+}
+
+class WireReader {
+ public:
+  WireReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+
+  size_t position() const { return position_; }
+  size_t remaining() const { return size_ - position_; }
+
+  Status ReadU8(const char* field, uint8_t* value) {
+    SWARMLIO_RETURN_IF_ERROR(Require(field, 1));
+    *value = data_[position_++];
+    return Status::Ok();
+  }
+  Status ReadU32(const char* field, uint32_t* value) {
+    SWARMLIO_RETURN_IF_ERROR(Require(field, 4));
+    *value = LoadLittleEndian<uint32_t>(data_ + position_);
+    position_ += 4;
+    return Status::Ok();
+  }
+  Status ReadU64(const char* field, uint64_t* value) {
+    SWARMLIO_RETURN_IF_ERROR(Require(field, 8));
+    *value = LoadLittleEndian<uint64_t>(data_ + position_);
+    position_ += 8;
+    return Status::Ok();
+  }
+  Status ReadF32(const char* field, float* value) {
+    SWARMLIO_RETURN_IF_ERROR(Require(field, 4));
+    *value = LoadFloat32(data_ + position_);
+    position_ += 4;
+    return Status::Ok();
+  }
+  Status ReadF64(const char* field, double* value) {
+    SWARMLIO_RETURN_IF_ERROR(Require(field, 8));
+    *value = LoadFloat64(data_ + position_);
+    position_ += 8;
+    return Status::Ok();
+  }
+
+  /// Returns a pointer to the next `count` bytes and skips them.
+  Status ReadBytes(const char* field, size_t count, const uint8_t** bytes) {
+    SWARMLIO_RETURN_IF_ERROR(Require(field, count));
+    *bytes = data_ + position_;
+    position_ += count;
+    return Status::Ok();
+  }
+
+  /// Reads a uint32 length prefix and checks that `length * element_bytes`
+  /// bytes remain (element_bytes = the smallest possible element size).
+  Status ReadArrayLength(const char* field, size_t element_bytes, uint32_t* length) {
+    uint32_t n = 0;
+    SWARMLIO_RETURN_IF_ERROR(ReadU32(field, &n));
+    const uint64_t needed = static_cast<uint64_t>(n) * static_cast<uint64_t>(element_bytes);
+    if (needed > remaining()) {
+      return Status::DataLoss(std::string("field '") + field + "' claims " + std::to_string(n) +
+                              " elements (" + std::to_string(needed) + " bytes) but only " +
+                              std::to_string(remaining()) + " bytes remain at offset " +
+                              std::to_string(position_));
+    }
+    *length = n;
+    return Status::Ok();
+  }
+
+  /// Reads a ROS string (uint32 length + bytes).
+  Status ReadString(const char* field, std::string* value) {
+    uint32_t n = 0;
+    SWARMLIO_RETURN_IF_ERROR(ReadArrayLength(field, 1, &n));
+    value->assign(reinterpret_cast<const char*>(data_ + position_), n);
+    position_ += n;
+    return Status::Ok();
+  }
+
+  /// Fails if bytes remain (the message is longer than its type says).
+  Status ExpectEnd(const char* message_type) const {
+    if (remaining() == 0) return Status::Ok();
+    return Status::DataLoss(std::string(message_type) + ": " + std::to_string(remaining()) +
+                            " unexpected trailing bytes after offset " + std::to_string(position_));
+  }
+
+ private:
+  Status Require(const char* field, size_t count) const {
+    if (count <= remaining()) return Status::Ok();
+    return Status::DataLoss(std::string("message truncated reading field '") + field + "': need " +
+                            std::to_string(count) + " bytes at offset " +
+                            std::to_string(position_) + ", " + std::to_string(remaining()) +
+                            " remain");
+  }
+
+  const uint8_t* data_;
+  size_t size_;
+  size_t position_ = 0;
+};
+
+}  // namespace swarmlio::io::internal

@@ -1,0 +1,80 @@
+#include "swarmlio/io/bag_options.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "swarmlio/io/read_stats.h"
+
+namespace swarmlio::io {
+namespace {
+
+TEST(BagOptionsTest, DefaultsAreValid) {
+  EXPECT_EQ(BagReaderOptions().Validate(), "");
+  EXPECT_EQ(BagWriterOptions().Validate(), "");
+  EXPECT_EQ(BagReaderOptions().imu_topic, "/livox/imu");
+  EXPECT_EQ(BagReaderOptions().lidar_topic, "/livox/lidar");
+  EXPECT_EQ(BagReaderOptions().ground_truth_topic, "/ground_truth/pose");
+  EXPECT_EQ(BagReaderOptions().point_time_field, "");
+}
+
+TEST(BagOptionsTest, ValidateNamesTheKey) {
+  BagReaderOptions reader;
+  reader.lidar_topic = "";
+  EXPECT_NE(reader.Validate().find("lidar_topic"), std::string::npos);
+  reader = BagReaderOptions();
+  reader.lidar_topic = reader.imu_topic;
+  EXPECT_NE(reader.Validate().find("lidar_topic"), std::string::npos);
+  reader = BagReaderOptions();
+  reader.max_message_mib = -1;
+  EXPECT_NE(reader.Validate().find("max_message_mib"), std::string::npos);
+
+  BagWriterOptions writer;
+  writer.point_time_field = "x";
+  EXPECT_NE(writer.Validate().find("point_time_field"), std::string::npos);
+  writer = BagWriterOptions();
+  writer.ground_truth_topic = writer.lidar_topic;
+  EXPECT_NE(writer.Validate(), "");
+}
+
+TEST(BagOptionsTest, EnumNamesRoundTrip) {
+  for (const char* name : {"s", "ms", "us", "ns"}) {
+    PointTimeUnit unit = PointTimeUnit::kSecond;
+    ASSERT_TRUE(config::EnumFromString(name, &unit)) << name;
+    EXPECT_STREQ(config::EnumToString(unit), name);
+  }
+  EXPECT_EQ(config::EnumChoices<PointTimeUnit>(), "s, ms, us, ns");
+  PointTimeUnit unit = PointTimeUnit::kSecond;
+  EXPECT_FALSE(config::EnumFromString("seconds", &unit));
+  EXPECT_EQ(TicksPerSecond(PointTimeUnit::kSecond), 1.0);
+  EXPECT_EQ(TicksPerSecond(PointTimeUnit::kMillisecond), 1e3);
+  EXPECT_EQ(TicksPerSecond(PointTimeUnit::kMicrosecond), 1e6);
+  EXPECT_EQ(TicksPerSecond(PointTimeUnit::kNanosecond), 1e9);
+  LidarFormat format = LidarFormat::kLivoxCustomMsg;
+  ASSERT_TRUE(config::EnumFromString("pointcloud2", &format));
+  EXPECT_EQ(format, LidarFormat::kPointCloud2);
+  BagCompression compression = BagCompression::kNone;
+  ASSERT_TRUE(config::EnumFromString("lz4", &compression));
+  EXPECT_EQ(compression, BagCompression::kLz4);
+}
+
+TEST(BagOptionsTest, OptionsAreVisitable) {
+  static_assert(config::IsOptionsStruct<BagReaderOptions>::value);
+  static_assert(config::IsOptionsStruct<BagWriterOptions>::value);
+  int count = 0;
+  BagReaderOptions options;
+  options.VisitFields([&count](const char*, auto&, const config::FieldSpec&) { ++count; });
+  EXPECT_EQ(count, 8);
+}
+
+TEST(ReadStatsTest, NamesAndSummary) {
+  ReadStats stats;
+  stats.skipped[static_cast<size_t>(SkipReason::kScanEmpty)] = 2;
+  stats.skipped[static_cast<size_t>(SkipReason::kImuNonFinite)] = 1;
+  EXPECT_EQ(stats.TotalSkipped(), 3);
+  EXPECT_STREQ(SkipReasonName(SkipReason::kMalformedMessage), "malformed_message");
+  EXPECT_NE(stats.ToString().find("skipped.scan_empty: 2"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace swarmlio::io
