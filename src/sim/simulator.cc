@@ -135,7 +135,8 @@ Status Simulator::RunDrone(int drone, DroneSink* sink, DroneStats* stats) const 
       out.y = static_cast<float>(p.p_in_lidar.y());
       out.z = static_cast<float>(p.p_in_lidar.z());
       out.reflectivity = static_cast<float>(p.reflectivity);
-      out.offset_time_s = p.t_s - sim_scan.start_time_s;
+      // The sensor reports integer nanoseconds: quantise like the log will.
+      out.offset_time_s = StampSeconds(StampNs(drone, p.t_s) - scan.stamp_ns);
       out.tag = 0x10;  // Livox: single return, normal point
       out.line = p.line;
       if (p.object >= 0 && p.object < static_cast<int>(drones_.size())) {

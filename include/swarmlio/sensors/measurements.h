@@ -14,7 +14,9 @@
 
 namespace swarmlio {
 
-inline double StampSeconds(int64_t stamp_ns) { return static_cast<double>(stamp_ns) * 1e-9; }
+/// Correctly rounded (division, not multiplication by 1e-9), so every module
+/// converting nanoseconds this way gets bit-identical seconds.
+inline double StampSeconds(int64_t stamp_ns) { return static_cast<double>(stamp_ns) / 1e9; }
 
 /// One IMU sample. Acceleration is the specific force as the device reports
 /// it (m/s^2 for most IMUs, g for Livox built-in IMUs; the estimator's IMU
