@@ -12,20 +12,6 @@ std::string CheckTopic(const char* key, const std::string& topic, bool required)
 
 }  // namespace
 
-double TicksPerSecond(PointTimeUnit unit) {
-  switch (unit) {
-    case PointTimeUnit::kSecond:
-      return 1.0;
-    case PointTimeUnit::kMillisecond:
-      return 1e3;
-    case PointTimeUnit::kMicrosecond:
-      return 1e6;
-    case PointTimeUnit::kNanosecond:
-      return 1e9;
-  }
-  return 1.0;
-}
-
 std::string BagReaderOptions::Validate() const {
   std::string error = config::ValidateFields(*this);
   if (error.empty()) error = CheckTopic("imu_topic", imu_topic, true);

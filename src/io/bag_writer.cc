@@ -71,7 +71,7 @@ class BagWriter::Impl {
 
   Status WriteScan(const LidarScan& scan, int64_t record_time_ns) {
     const std::string context = "bag '" + path_ + "': scan";
-    if (options_.lidar_format == LidarFormat::kLivoxCustomMsg) {
+    if (options_.lidar_format == LidarMessageFormat::kLivoxCustomMsg) {
       internal::LivoxCustomMsg msg;
       SWARMLIO_RETURN_IF_ERROR(
           internal::EncodeLivoxCustomMsg(scan, scan_seq_, &msg).WithContext(context));

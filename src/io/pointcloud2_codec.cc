@@ -241,7 +241,7 @@ Status DecodePointCloud2(const uint8_t* data,
                             std::to_string(data_bytes));
   }
 
-  const double ticks_per_s = TicksPerSecond(options.time_unit);
+  const double ticks_per_s = TimestampUnitTicksPerSecond(options.time_unit);
   scan->points.resize(num_points);
   size_t index = 0;
   for (uint32_t row = 0; row < height; ++row) {
@@ -263,7 +263,7 @@ Status DecodePointCloud2(const uint8_t* data,
 
 Status EncodePointCloud2(const LidarScan& scan,
                          uint32_t seq,
-                         PointTimeUnit time_unit,
+                         TimestampUnit time_unit,
                          const std::string& time_field,
                          sensor_msgs::PointCloud2* msg) {
   static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "little-endian host required");
@@ -290,7 +290,7 @@ Status EncodePointCloud2(const LidarScan& scan,
   msg->point_step = kPointStep;
   msg->row_step = kPointStep * n;
   msg->data.assign(static_cast<size_t>(msg->row_step), 0);
-  const double ticks_per_s = TicksPerSecond(time_unit);
+  const double ticks_per_s = TimestampUnitTicksPerSecond(time_unit);
   bool dense = true;
   for (uint32_t i = 0; i < n; ++i) {
     const LidarPoint& point = scan.points[i];

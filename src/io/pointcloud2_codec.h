@@ -21,7 +21,7 @@
 namespace swarmlio::io::internal {
 
 struct PointCloud2DecodeOptions {
-  PointTimeUnit time_unit = PointTimeUnit::kMicrosecond;
+  TimestampUnit time_unit = TimestampUnit::kMicrosecond;
   std::string time_field;  // "" = first of "time", "t", "timestamp", "offset_time"
 };
 
@@ -43,7 +43,7 @@ Status DecodePointCloud2(const uint8_t* data,
 /// `time_unit`), tag and line (UINT8 at 24 25), 6 bytes of zero padding.
 Status EncodePointCloud2(const LidarScan& scan,
                          uint32_t seq,
-                         PointTimeUnit time_unit,
+                         TimestampUnit time_unit,
                          const std::string& time_field,
                          sensor_msgs::PointCloud2* msg);
 

@@ -8,14 +8,9 @@
 namespace swarmlio::sim {
 
 io::BagWriterOptions BagOptionsFor(const io::BagWriterOptions& base, const LidarOptions& lidar) {
-  // The io enums spell their values like the sensor description's (both are
-  // the YAML names: livox_custom_msg / pointcloud2, s / ms / us / ns).
   io::BagWriterOptions options = base;
-  const bool mapped = config::EnumFromString(config::EnumToString(lidar.message_format),
-                                             &options.lidar_format) &&
-                      config::EnumFromString(config::EnumToString(lidar.timestamp_unit),
-                                             &options.point_time_unit);
-  CHECK(mapped) << "io and sensor enum names diverged";
+  options.lidar_format = lidar.message_format;
+  options.point_time_unit = lidar.timestamp_unit;
   return options;
 }
 

@@ -39,20 +39,20 @@ TEST(BagOptionsTest, ValidateNamesTheKey) {
 
 TEST(BagOptionsTest, EnumNamesRoundTrip) {
   for (const char* name : {"s", "ms", "us", "ns"}) {
-    PointTimeUnit unit = PointTimeUnit::kSecond;
+    TimestampUnit unit = TimestampUnit::kSecond;
     ASSERT_TRUE(config::EnumFromString(name, &unit)) << name;
     EXPECT_STREQ(config::EnumToString(unit), name);
   }
-  EXPECT_EQ(config::EnumChoices<PointTimeUnit>(), "s, ms, us, ns");
-  PointTimeUnit unit = PointTimeUnit::kSecond;
+  EXPECT_EQ(config::EnumChoices<TimestampUnit>(), "s, ms, us, ns");
+  TimestampUnit unit = TimestampUnit::kSecond;
   EXPECT_FALSE(config::EnumFromString("seconds", &unit));
-  EXPECT_EQ(TicksPerSecond(PointTimeUnit::kSecond), 1.0);
-  EXPECT_EQ(TicksPerSecond(PointTimeUnit::kMillisecond), 1e3);
-  EXPECT_EQ(TicksPerSecond(PointTimeUnit::kMicrosecond), 1e6);
-  EXPECT_EQ(TicksPerSecond(PointTimeUnit::kNanosecond), 1e9);
-  LidarFormat format = LidarFormat::kLivoxCustomMsg;
+  EXPECT_EQ(TimestampUnitTicksPerSecond(TimestampUnit::kSecond), 1.0);
+  EXPECT_EQ(TimestampUnitTicksPerSecond(TimestampUnit::kMillisecond), 1e3);
+  EXPECT_EQ(TimestampUnitTicksPerSecond(TimestampUnit::kMicrosecond), 1e6);
+  EXPECT_EQ(TimestampUnitTicksPerSecond(TimestampUnit::kNanosecond), 1e9);
+  LidarMessageFormat format = LidarMessageFormat::kLivoxCustomMsg;
   ASSERT_TRUE(config::EnumFromString("pointcloud2", &format));
-  EXPECT_EQ(format, LidarFormat::kPointCloud2);
+  EXPECT_EQ(format, LidarMessageFormat::kPointCloud2);
   BagCompression compression = BagCompression::kNone;
   ASSERT_TRUE(config::EnumFromString("lz4", &compression));
   EXPECT_EQ(compression, BagCompression::kLz4);

@@ -332,7 +332,7 @@ TEST(BagReaderErrorTest, StampsGoingBackwardsAreSkippedAndCounted) {
 
 TEST(BagReaderErrorTest, EmptyScansAreSkippedAndCounted) {
   TempDir dir;
-  for (LidarFormat format : {LidarFormat::kLivoxCustomMsg, LidarFormat::kPointCloud2}) {
+  for (LidarMessageFormat format : {LidarMessageFormat::kLivoxCustomMsg, LidarMessageFormat::kPointCloud2}) {
     const std::string path = dir.File("empty.bag");
     BagWriterOptions options;
     options.lidar_format = format;

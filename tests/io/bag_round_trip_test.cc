@@ -67,13 +67,13 @@ TEST(BagRoundTripTest, ImuPoseAndCustomMsgBitExact) {
   EXPECT_EQ(stats.TotalSkipped(), 0);
 }
 
-class BagPointCloud2UnitTest : public ::testing::TestWithParam<PointTimeUnit> {};
+class BagPointCloud2UnitTest : public ::testing::TestWithParam<TimestampUnit> {};
 
 TEST_P(BagPointCloud2UnitTest, PointCloud2BitExact) {
   TempDir dir;
   const std::string path = dir.File("cloud.bag");
   BagWriterOptions write_options;
-  write_options.lidar_format = LidarFormat::kPointCloud2;
+  write_options.lidar_format = LidarMessageFormat::kPointCloud2;
   write_options.point_time_unit = GetParam();
   write_options.point_time_field = "offset_t";
   write_options.lidar_topic = "/points";
@@ -106,11 +106,11 @@ TEST_P(BagPointCloud2UnitTest, PointCloud2BitExact) {
 
 INSTANTIATE_TEST_SUITE_P(AllUnits,
                          BagPointCloud2UnitTest,
-                         ::testing::Values(PointTimeUnit::kSecond,
-                                           PointTimeUnit::kMillisecond,
-                                           PointTimeUnit::kMicrosecond,
-                                           PointTimeUnit::kNanosecond),
-                         [](const ::testing::TestParamInfo<PointTimeUnit>& param_info) {
+                         ::testing::Values(TimestampUnit::kSecond,
+                                           TimestampUnit::kMillisecond,
+                                           TimestampUnit::kMicrosecond,
+                                           TimestampUnit::kNanosecond),
+                         [](const ::testing::TestParamInfo<TimestampUnit>& param_info) {
                            return std::string(config::EnumToString(param_info.param));
                          });
 
@@ -139,7 +139,7 @@ TEST(BagRoundTripTest, DebianClassesReadWhatWeWrite) {
   TempDir dir;
   const std::string path = dir.File("debian.bag");
   BagWriterOptions options;
-  options.lidar_format = LidarFormat::kPointCloud2;
+  options.lidar_format = LidarMessageFormat::kPointCloud2;
   testing::WriteSimpleBag(path, options, 21);
   rosbag::Bag bag;
   bag.open(path, rosbag::bagmode::Read);

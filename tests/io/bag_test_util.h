@@ -55,7 +55,7 @@ inline void WriteSimpleBag(const std::string& path,
     const int64_t stamp = t0 + i * 5000000LL;
     ASSERT_TRUE(writer->WriteImu(MakeImu(i, stamp)).ok());
     if (i % 20 == 0) {
-      const LidarScan scan = options.lidar_format == LidarFormat::kLivoxCustomMsg
+      const LidarScan scan = options.lidar_format == LidarMessageFormat::kLivoxCustomMsg
                                  ? MakeLivoxScan(i, stamp, points_per_scan)
                                  : MakeScan(i, stamp, points_per_scan);
       // Drivers publish a scan at its end: record time after the stamp.

@@ -118,7 +118,7 @@ TEST(PointCloud2CodecTest, OrganizedCloudWithMixedDatatypesAndPadding) {
     }
   }
   PointCloud2DecodeOptions options;
-  options.time_unit = PointTimeUnit::kNanosecond;
+  options.time_unit = TimestampUnit::kNanosecond;
   LidarScan scan;
   PointCloud2DecodeInfo info;
   ASSERT_TRUE(Decode(cloud, options, &scan, &info).ok());
@@ -175,7 +175,7 @@ TEST_P(PointCloud2DatatypeTest, AnyDatatypeForEveryField) {
     Put(&cloud, 0, c, time, 4 * c);
   }
   PointCloud2DecodeOptions options;
-  options.time_unit = PointTimeUnit::kMillisecond;
+  options.time_unit = TimestampUnit::kMillisecond;
   LidarScan scan;
   PointCloud2DecodeInfo info;
   ASSERT_TRUE(Decode(cloud, options, &scan, &info).ok());
@@ -214,7 +214,7 @@ TEST(PointCloud2CodecTest, TimeFieldAutoDetectionAndConfiguredName) {
     LidarScan scan;
     PointCloud2DecodeInfo info;
     PointCloud2DecodeOptions options;
-    options.time_unit = PointTimeUnit::kSecond;
+    options.time_unit = TimestampUnit::kSecond;
     ASSERT_TRUE(Decode(cloud, options, &scan, &info).ok()) << name;
     EXPECT_EQ(info.time_field, name);
     EXPECT_EQ(scan.points[0].offset_time_s, 0.5) << name;
@@ -228,7 +228,7 @@ TEST(PointCloud2CodecTest, TimeFieldAutoDetectionAndConfiguredName) {
   Put(&cloud, 0, 0, {"stamp_us", 12, PointField::UINT32}, 250);
   Put(&cloud, 0, 0, {"time", 16, PointField::FLOAT32}, 99);
   PointCloud2DecodeOptions options;
-  options.time_unit = PointTimeUnit::kMicrosecond;
+  options.time_unit = TimestampUnit::kMicrosecond;
   options.time_field = "stamp_us";
   LidarScan scan;
   PointCloud2DecodeInfo info;
@@ -311,10 +311,10 @@ TEST(PointCloud2CodecTest, EmptyCloudDecodesToNoPoints) {
   EXPECT_TRUE(scan.points.empty());
 }
 
-class PointCloud2UnitTest : public ::testing::TestWithParam<PointTimeUnit> {};
+class PointCloud2UnitTest : public ::testing::TestWithParam<TimestampUnit> {};
 
 TEST_P(PointCloud2UnitTest, EncodeDecodeRoundTripAndRosView) {
-  const PointTimeUnit unit = GetParam();
+  const TimestampUnit unit = GetParam();
   const LidarScan in = testing::MakeScan(2, 7000000001LL, 50);
   sensor_msgs::PointCloud2 msg;
   ASSERT_TRUE(EncodePointCloud2(in, 4, unit, "time", &msg).ok());
@@ -333,7 +333,7 @@ TEST_P(PointCloud2UnitTest, EncodeDecodeRoundTripAndRosView) {
     EXPECT_EQ(it_x[1], p.y);
     EXPECT_EQ(it_x[2], p.z);
     EXPECT_EQ(*it_i, p.reflectivity);
-    EXPECT_EQ(*it_t, p.offset_time_s * TicksPerSecond(unit));
+    EXPECT_EQ(*it_t, p.offset_time_s * TimestampUnitTicksPerSecond(unit));
     EXPECT_EQ(*it_line, p.line);
     ++it_x;
     ++it_i;
@@ -351,11 +351,11 @@ TEST_P(PointCloud2UnitTest, EncodeDecodeRoundTripAndRosView) {
 
 INSTANTIATE_TEST_SUITE_P(AllUnits,
                          PointCloud2UnitTest,
-                         ::testing::Values(PointTimeUnit::kSecond,
-                                           PointTimeUnit::kMillisecond,
-                                           PointTimeUnit::kMicrosecond,
-                                           PointTimeUnit::kNanosecond),
-                         [](const ::testing::TestParamInfo<PointTimeUnit>& param_info) {
+                         ::testing::Values(TimestampUnit::kSecond,
+                                           TimestampUnit::kMillisecond,
+                                           TimestampUnit::kMicrosecond,
+                                           TimestampUnit::kNanosecond),
+                         [](const ::testing::TestParamInfo<TimestampUnit>& param_info) {
                            return std::string(config::EnumToString(param_info.param));
                          });
 

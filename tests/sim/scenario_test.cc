@@ -172,10 +172,10 @@ drones:
   EXPECT_EQ(s.drones[1].lidar.sensor.max_range_m, LidarOptions().max_range_m);
 
   const io::BagWriterOptions bag = BagOptionsFor(s.bag, d.lidar.sensor);
-  EXPECT_EQ(bag.lidar_format, io::LidarFormat::kPointCloud2);
-  EXPECT_EQ(bag.point_time_unit, io::PointTimeUnit::kMicrosecond);
+  EXPECT_EQ(bag.lidar_format, LidarMessageFormat::kPointCloud2);
+  EXPECT_EQ(bag.point_time_unit, TimestampUnit::kMicrosecond);
   EXPECT_EQ(BagOptionsFor(s.bag, s.drones[1].lidar.sensor).lidar_format,
-            io::LidarFormat::kLivoxCustomMsg);
+            LidarMessageFormat::kLivoxCustomMsg);
 
   // An override that breaks the merged sensor names the drone's key and line.
   const Status bad = ParseScenario(WithPresets(R"(
@@ -202,7 +202,7 @@ TEST(Scenario, BagOptionsFollowTheSensorDescription) {
     lidar.timestamp_unit = unit;
     const io::BagWriterOptions options = BagOptionsFor(base, lidar);
     EXPECT_STREQ(config::EnumToString(options.point_time_unit), name);
-    EXPECT_EQ(options.lidar_format, io::LidarFormat::kPointCloud2);
+    EXPECT_EQ(options.lidar_format, LidarMessageFormat::kPointCloud2);
     EXPECT_EQ(options.compression, io::BagCompression::kLz4);
   }
 }

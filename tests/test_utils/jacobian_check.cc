@@ -17,8 +17,12 @@ namespace swarmlio::testing {
            << "expected one manifold and one parameter pointer per parameter block ("
            << cost.parameter_block_sizes().size() << ")";
   }
+  // Ceres's GradientChecker differentiates with Ridders' method; its default
+  // first step (1e-2 relative) is too coarse near the identity rotation and
+  // for large-error prior residuals, so start smaller.
   ceres::NumericDiffOptions options;
   options.relative_step_size = 1e-6;
+  options.ridders_relative_initial_step_size = 1e-4;
   ceres::GradientChecker checker(&cost, &manifolds, options);
   ceres::GradientChecker::ProbeResults results;
   if (checker.Probe(parameters.data(), relative_tolerance, &results)) {

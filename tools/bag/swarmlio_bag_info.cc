@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
   if (!swarmlio::config::EnumFromString(FLAGS_point_time_unit, &options.point_time_unit)) {
     std::fprintf(stderr, "swarmlio_bag_info: error: --point_time_unit '%s' is not one of %s\n",
                  FLAGS_point_time_unit.c_str(),
-                 swarmlio::config::EnumChoices<io::PointTimeUnit>().c_str());
+                 swarmlio::config::EnumChoices<swarmlio::TimestampUnit>().c_str());
     return 2;
   }
 

@@ -9,19 +9,9 @@
 #include <utility>
 
 #include "swarmlio/config/option_fields.h"
+#include "swarmlio/sensors/lidar_formats.h"
 
 namespace swarmlio::io {
-
-/// Unit of the per-point time field of a sensor_msgs/PointCloud2 (FAST-LIO's
-/// `timestamp_unit`). The field holds the point time relative to the header
-/// stamp in this unit.
-enum class PointTimeUnit { kSecond, kMillisecond, kMicrosecond, kNanosecond };
-
-/// Number of `unit` ticks in one second (1, 1e3, 1e6 or 1e9).
-double TicksPerSecond(PointTimeUnit unit);
-
-/// Message type the writer uses for LiDAR scans.
-enum class LidarFormat { kLivoxCustomMsg, kPointCloud2 };
 
 /// Chunk compression of a written bag.
 enum class BagCompression { kNone, kLz4, kBz2 };
@@ -30,7 +20,7 @@ struct BagReaderOptions {
   std::string imu_topic = "/livox/imu";      // sensor_msgs/Imu; must exist
   std::string lidar_topic = "/livox/lidar";  // PointCloud2 or Livox CustomMsg; must exist
   std::string ground_truth_topic = "/ground_truth/pose";  // geometry_msgs/PoseStamped; optional
-  PointTimeUnit point_time_unit = PointTimeUnit::kMicrosecond;
+  TimestampUnit point_time_unit = TimestampUnit::kMicrosecond;
   std::string point_time_field;          // "" = auto: "time", "t", "timestamp", "offset_time"
   bool skip_malformed_messages = false;  // false: a malformed message is an error
   bool verify_chunks = true;             // check every chunk's records on open (one extra pass)
@@ -65,8 +55,8 @@ struct BagWriterOptions {
   std::string imu_topic = "/livox/imu";
   std::string lidar_topic = "/livox/lidar";
   std::string ground_truth_topic = "/ground_truth/pose";
-  LidarFormat lidar_format = LidarFormat::kLivoxCustomMsg;
-  PointTimeUnit point_time_unit = PointTimeUnit::kMicrosecond;  // PointCloud2 only
+  LidarMessageFormat lidar_format = LidarMessageFormat::kLivoxCustomMsg;
+  TimestampUnit point_time_unit = TimestampUnit::kMicrosecond;  // PointCloud2 only
   std::string point_time_field = "time";                        // PointCloud2 only
   BagCompression compression = BagCompression::kNone;
 
@@ -90,24 +80,6 @@ struct BagWriterOptions {
 }  // namespace swarmlio::io
 
 namespace swarmlio::config {
-
-template <>
-struct EnumTraits<io::PointTimeUnit> {
-  static constexpr std::array<std::pair<io::PointTimeUnit, const char*>, 4> kNames{{
-      {io::PointTimeUnit::kSecond, "s"},
-      {io::PointTimeUnit::kMillisecond, "ms"},
-      {io::PointTimeUnit::kMicrosecond, "us"},
-      {io::PointTimeUnit::kNanosecond, "ns"},
-  }};
-};
-
-template <>
-struct EnumTraits<io::LidarFormat> {
-  static constexpr std::array<std::pair<io::LidarFormat, const char*>, 2> kNames{{
-      {io::LidarFormat::kLivoxCustomMsg, "livox_custom_msg"},
-      {io::LidarFormat::kPointCloud2, "pointcloud2"},
-  }};
-};
 
 template <>
 struct EnumTraits<io::BagCompression> {

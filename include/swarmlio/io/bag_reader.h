@@ -6,6 +6,9 @@
 // records come out ordered by stamp_ns (ties: IMU, then scan, then pose).
 // Records that fail a check are skipped and counted in stats() (see
 // read_stats.h); a malformed message or a broken bag is an error Status.
+// Before rosbag sees the file its structure is checked (every length and
+// offset against the file size, and with options.verify_chunks every chunk's
+// records), so truncated or corrupt bags give an error, not a crash.
 //
 // ROS headers stay in src/io; this header needs none.
 #pragma once

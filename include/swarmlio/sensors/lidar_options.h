@@ -19,28 +19,11 @@
 #include <utility>
 
 #include "swarmlio/config/option_fields.h"
+#include "swarmlio/sensors/lidar_formats.h"
 
 namespace swarmlio {
 
 enum class LidarType { kLivoxAvia, kLivoxMid360, kSpinning };
-enum class LidarMessageFormat { kLivoxCustomMsg, kPointCloud2 };
-/// Unit of the per-point time field of the incoming message.
-enum class TimestampUnit { kSecond, kMillisecond, kMicrosecond, kNanosecond };
-
-/// Seconds per tick of `unit`.
-constexpr double TimestampUnitToSeconds(TimestampUnit unit) {
-  switch (unit) {
-    case TimestampUnit::kSecond:
-      return 1.0;
-    case TimestampUnit::kMillisecond:
-      return 1e-3;
-    case TimestampUnit::kMicrosecond:
-      return 1e-6;
-    case TimestampUnit::kNanosecond:
-      return 1e-9;
-  }
-  return 1.0;
-}
 
 }  // namespace swarmlio
 
@@ -52,24 +35,6 @@ struct EnumTraits<LidarType> {
       {LidarType::kLivoxAvia, "livox_avia"},
       {LidarType::kLivoxMid360, "livox_mid360"},
       {LidarType::kSpinning, "spinning"},
-  }};
-};
-
-template <>
-struct EnumTraits<LidarMessageFormat> {
-  static constexpr std::array<std::pair<LidarMessageFormat, const char*>, 2> kNames{{
-      {LidarMessageFormat::kLivoxCustomMsg, "livox_custom_msg"},
-      {LidarMessageFormat::kPointCloud2, "pointcloud2"},
-  }};
-};
-
-template <>
-struct EnumTraits<TimestampUnit> {
-  static constexpr std::array<std::pair<TimestampUnit, const char*>, 4> kNames{{
-      {TimestampUnit::kSecond, "s"},
-      {TimestampUnit::kMillisecond, "ms"},
-      {TimestampUnit::kMicrosecond, "us"},
-      {TimestampUnit::kNanosecond, "ns"},
   }};
 };
 

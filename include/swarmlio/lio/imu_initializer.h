@@ -1,0 +1,173 @@
+// IMU initialization from a static start (docs/imu.md, "Initialization").
+//
+// The initializer keeps a sliding window of the latest IMU samples (a sample
+// count, default 200 = FAST-LIO's MAX_INI_COUNT, or a duration) and, when
+// asked, estimates from the window mean:
+//   - the global frame G := the IMU frame at the last sample of the window, so
+//     R_G_b = I and p_b_in_G = v_b_in_G = 0;
+//   - gyro bias b_g = mean angular rate [rad/s];
+//   - gravity g_in_G = -s * k * mean(a_m) [m/s^2], s = acceleration_sign,
+//     k = 1 (m/s^2) or nominal_gravity_m_s2 (g units). Its magnitude |g_in_G|
+//     is measured, not assumed;
+//   - accelerometer bias b_a = 0: it is not observable at a static start (it
+//     is indistinguishable from a tilt of gravity), so it gets a prior
+//     covariance and gravity gets the exactly anti-correlated uncertainty.
+// It refuses (FailedPrecondition, with the measured standard deviations and
+// the thresholds) a window that is not static, and rejects NaN samples
+// (InvalidArgument).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/config/option_fields.h"
+#include "swarmlio/sensors/imu_options.h"
+#include "swarmlio/sensors/measurements.h"
+#include "swarmlio/state/swarm_state.h"
+
+namespace swarmlio {
+
+/// Acceleration unit as configured for initialization: a fixed unit, or
+/// detected from |mean a_m| at the static start (~1 -> g, ~9.8 -> m/s^2).
+enum class AccelerationUnitSetting { kMetersPerSecondSquared, kStandardGravity, kAuto };
+
+}  // namespace swarmlio
+
+namespace swarmlio::config {
+
+template <>
+struct EnumTraits<AccelerationUnitSetting> {
+  static constexpr std::array<std::pair<AccelerationUnitSetting, const char*>, 3> kNames{{
+      {AccelerationUnitSetting::kMetersPerSecondSquared, "m_s2"},
+      {AccelerationUnitSetting::kStandardGravity, "g"},
+      {AccelerationUnitSetting::kAuto, "auto"},
+  }};
+};
+
+}  // namespace swarmlio::config
+
+namespace swarmlio {
+
+struct ImuInitializerOptions {
+  // Samples averaged (FAST-LIO MAX_INI_COUNT); used when window_duration_s == 0.
+  int window_num_samples = 200;
+  double window_duration_s = 0.0;  // > 0: average over this duration instead [s]
+  AccelerationUnitSetting acceleration_unit = AccelerationUnitSetting::kAuto;
+  int acceleration_sign = 1;  // +1: device reports specific force (a - g); -1: it reports -(a - g)
+  // Converts g units to m/s^2; reference of the magnitude check [m/s^2].
+  double nominal_gravity_m_s2 = 9.81;
+  double max_gravity_error_ratio = 0.1;  // | |g| / nominal - 1 | allowed after unit conversion
+  double max_gyro_stddev_rad_s = 0.05;   // static test: sqrt(trace Cov(w_m)) [rad/s]
+  double max_accel_stddev_m_s2 = 0.3;    // static test: sqrt(trace Cov(a_m)) [m/s^2]
+  double max_gyro_bias_rad_s = 0.2;      // |mean w_m| above this = not static (steady turn) [rad/s]
+  // Initial covariance (1-sigma, per axis). G is defined by the initial pose,
+  // so pose and velocity are known up to the conditioning floors below.
+  double initial_rotation_stddev_rad = 1e-3;    // [rad]
+  double initial_position_stddev_m = 1e-3;      // [m]
+  double initial_velocity_stddev_m_s = 1e-2;    // static start [m/s]
+  double gyro_bias_stddev_floor_rad_s = 1e-3;   // added to the standard error of the mean [rad/s]
+  double initial_accel_bias_stddev_m_s2 = 0.1;  // prior on the unobservable b_a [m/s^2]
+  double gravity_stddev_floor_m_s2 = 1e-3;      // added to the acc-mean standard error [m/s^2]
+
+  template <class V>
+  void VisitFields(V&& v) {
+    using config::FieldSpec;
+    v("window_num_samples", window_num_samples,
+      FieldSpec::InRange(2.0, 1e6, "", "samples averaged (when window_duration_s is 0)"));
+    v("window_duration_s", window_duration_s,
+      FieldSpec::InRange(0.0, 60.0, "s", "duration averaged instead of a count (0 = use count)"));
+    v("acceleration_unit", acceleration_unit,
+      FieldSpec::Doc("unit of the reported acceleration: m_s2, g or auto (detected at rest)"));
+    v("acceleration_sign", acceleration_sign,
+      FieldSpec::InRange(-1.0, 1.0, "", "+1: specific force (a - g); -1: device reports -(a - g)"));
+    v("nominal_gravity_m_s2", nominal_gravity_m_s2,
+      FieldSpec::InRange(9.7, 9.9, "m/s^2", "g-unit conversion and magnitude-check reference"));
+    v("max_gravity_error_ratio", max_gravity_error_ratio,
+      FieldSpec::InRange(0.0, 0.5, "", "allowed relative error of the measured |g|"));
+    v("max_gyro_stddev_rad_s", max_gyro_stddev_rad_s,
+      FieldSpec::Positive("rad/s", "static test: gyro standard deviation"));
+    v("max_accel_stddev_m_s2", max_accel_stddev_m_s2,
+      FieldSpec::Positive("m/s^2", "static test: accelerometer standard deviation"));
+    v("max_gyro_bias_rad_s", max_gyro_bias_rad_s,
+      FieldSpec::Positive("rad/s", "static test: largest plausible gyro bias"));
+    v("initial_rotation_stddev_rad", initial_rotation_stddev_rad,
+      FieldSpec::Positive("rad", "initial attitude 1-sigma"));
+    v("initial_position_stddev_m", initial_position_stddev_m,
+      FieldSpec::Positive("m", "initial position 1-sigma"));
+    v("initial_velocity_stddev_m_s", initial_velocity_stddev_m_s,
+      FieldSpec::Positive("m/s", "initial velocity 1-sigma"));
+    v("gyro_bias_stddev_floor_rad_s", gyro_bias_stddev_floor_rad_s,
+      FieldSpec::Positive("rad/s", "floor added to the gyro-bias standard error"));
+    v("initial_accel_bias_stddev_m_s2", initial_accel_bias_stddev_m_s2,
+      FieldSpec::Positive("m/s^2", "prior 1-sigma of the unobservable accelerometer bias"));
+    v("gravity_stddev_floor_m_s2", gravity_stddev_floor_m_s2,
+      FieldSpec::Positive("m/s^2", "floor added to the gravity standard error"));
+  }
+
+  /// "" when valid, else "key: reason".
+  std::string Validate() const;
+};
+
+/// Result of a successful initialization.
+struct ImuInitialization {
+  int64_t stamp_ns = 0;   // time of the state: the last sample of the window
+  ImuSample last_sample;  // that sample, raw (the propagator's first input)
+  EgoState state;         // R_G_b = I, p = v = 0, b_g, b_a = 0, g_in_G
+  Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim> covariance =
+      Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>::Zero();
+  AccelerationUnit acceleration_unit =
+      AccelerationUnit::kMetersPerSecondSquared;  // used / detected
+  bool unit_detected = false;                     // true when acceleration_unit came from "auto"
+  double acceleration_to_m_s2 = 1.0;              // signed factor: a [m/s^2] = factor * reported a
+  double gravity_magnitude_m_s2 = 0.0;            // |g_in_G| as measured
+  int num_samples = 0;
+  double gyro_stddev_rad_s = 0.0;  // sqrt(trace Cov(w_m)) over the window
+  double accel_stddev_m_s2 = 0.0;  // sqrt(trace Cov(a_m)) over the window, in m/s^2
+
+  /// One-line human-readable report (the library does not print it).
+  std::string Summary() const;
+};
+
+class ImuInitializer {
+ public:
+  /// InvalidArgument when `options` do not validate.
+  static Status Create(const ImuInitializerOptions& options,
+                       std::unique_ptr<ImuInitializer>* initializer);
+
+  /// Adds a sample to the sliding window. Non-finite values: InvalidArgument
+  /// (sample dropped, counted). Stamps not after the previous sample are
+  /// skipped and counted (Ok).
+  Status AddSample(const ImuSample& sample);
+
+  /// True when the window holds enough samples (or spans the duration).
+  bool WindowFull() const;
+
+  /// Estimates the initial state from the current window. FailedPrecondition
+  /// when the window is not full, the start is not static, or |g| does not
+  /// match the unit; the message names the measured values and thresholds.
+  Status Initialize(ImuInitialization* result) const;
+
+  /// Empties the window (counters are kept).
+  void Reset() { window_.clear(); }
+
+  int num_samples_in_window() const { return static_cast<int>(window_.size()); }
+  int num_rejected_non_finite() const { return num_rejected_non_finite_; }
+  int num_skipped_out_of_order() const { return num_skipped_out_of_order_; }
+
+ private:
+  explicit ImuInitializer(const ImuInitializerOptions& options) : options_(options) {}
+  int64_t DurationNs() const;
+
+  ImuInitializerOptions options_;
+  std::deque<ImuSample> window_;
+  int num_rejected_non_finite_ = 0;
+  int num_skipped_out_of_order_ = 0;
+};
+
+}  // namespace swarmlio

@@ -1,0 +1,85 @@
+// FitPlane: a local plane n^T q + d = 0 through the k nearest map neighbours
+// of a scan point, for the point-to-plane residual z = n^T (R_G_b p_b + p_b_in_G) + d
+// (paper eq. (4)).
+//
+// Method: PCA. The normal n is the eigenvector of the smallest eigenvalue of
+// the neighbours' scatter matrix about their centroid c, and d = -n^T c. This
+// is the total-least-squares plane (minimises the sum of squared orthogonal
+// distances). FAST-LIO instead solves A n' = -1 in least squares (the plane
+// n'^T q + 1 = 0), which cannot represent a plane through the origin of G and
+// minimises an algebraic, not geometric, error; PCA has neither problem and
+// costs one 3x3 closed-form eigen decomposition.
+//
+// Acceptance, in this order (the status names the first failed test):
+//   kTooFewPoints:    fewer than min_neighbors neighbours;
+//   kNeighborsTooFar: the farthest neighbour's squared distance to the query
+//                     exceeds max_neighbor_sq_distance_m2 (FAST-LIO: 5th-NN
+//                     squared distance > 5 m^2 -> no match);
+//   kDegenerate:      the neighbours lie on a line or a point (in-plane spread
+//                     sqrt(lambda_mid) < min_plane_extent_m), normal undefined;
+//   kNotPlanar:       some neighbour is farther than max_point_to_plane_m from
+//                     the plane (FAST-LIO esti_plane threshold 0.1 m).
+// Orientation: n is a unit vector with d <= 0 (the origin of G lies on the
+// negative side; for d == 0 the first non-zero component of n is positive),
+// so the same neighbours always give the same (n, d).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "swarmlio/config/option_fields.h"
+#include "swarmlio/lio/map_neighbor.h"
+
+namespace swarmlio::lio {
+
+struct PlaneFitOptions {
+  int min_neighbors = 5;                      // NUM_MATCH_POINTS
+  double max_neighbor_sq_distance_m2 = 5.0;   // farthest neighbour to the query [m^2]
+  double max_point_to_plane_m = 0.1;          // planarity: every neighbour within [m]
+  double min_plane_extent_m = 0.01;           // sqrt of the middle scatter eigenvalue [m]
+
+  template <class V>
+  void VisitFields(V&& v) {
+    using config::FieldSpec;
+    v("min_neighbors", min_neighbors,
+      FieldSpec::InRange(3.0, 100.0, "", "neighbours needed for a plane (NUM_MATCH_POINTS)"));
+    v("max_neighbor_sq_distance_m2", max_neighbor_sq_distance_m2,
+      FieldSpec::Positive("m^2", "reject when the farthest neighbour's squared distance to the "
+                                 "query exceeds this"));
+    v("max_point_to_plane_m", max_point_to_plane_m,
+      FieldSpec::Positive("m", "every neighbour must be this close to the plane"));
+    v("min_plane_extent_m", min_plane_extent_m,
+      FieldSpec::AtLeast(0.0, "m", "reject collinear neighbours (in-plane RMS spread below)"));
+  }
+  std::string Validate() const { return config::ValidateFields(*this); }
+};
+
+enum class PlaneFitStatus { kOk, kTooFewPoints, kNeighborsTooFar, kDegenerate, kNotPlanar };
+
+const char* ToString(PlaneFitStatus status);
+
+struct Plane {
+  Eigen::Vector3d normal_in_G = Eigen::Vector3d::UnitZ();  // unit normal n
+  double offset_m = 0.0;                 // d: n^T q + d = 0 for q on the plane [m]
+  double max_abs_residual_m = 0.0;       // max_i |n^T q_i + d| over the neighbours [m]
+  double rms_residual_m = 0.0;           // RMS of n^T q_i + d [m]
+  double curvature = 0.0;  // lambda_min / (sum of eigenvalues), 0 = flat, 1/3 = isotropic
+
+  /// Signed distance of `q_in_G` to the plane [m].
+  double SignedDistance(const Eigen::Vector3d& q_in_G) const {
+    return normal_in_G.dot(q_in_G) + offset_m;
+  }
+};
+
+/// Fits a plane to `points`; `farthest_sq_distance_m2` is the largest squared
+/// distance of a neighbour to the query. `*plane` is written on kOk only.
+PlaneFitStatus FitPlane(const std::vector<Eigen::Vector3d>& points,
+                        double farthest_sq_distance_m2, const PlaneFitOptions& options,
+                        Plane* plane);
+
+/// Same, from LocalMap::KNearest results.
+PlaneFitStatus FitPlane(const std::vector<Neighbor>& neighbors, const PlaneFitOptions& options,
+                        Plane* plane);
+
+}  // namespace swarmlio::lio

@@ -1,0 +1,226 @@
+#include "swarmlio/lio/imu_initializer.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace swarmlio {
+namespace {
+
+using L = ErrorStateLayout;
+
+bool IsFinite(const ImuSample& s) {
+  return s.angular_velocity_rad_s.allFinite() && s.linear_acceleration.allFinite();
+}
+
+// |mean a_m| ranges (raw units) that auto-detection accepts, as ratios of 1 g.
+constexpr double kAutoMinRatio = 0.5;
+constexpr double kAutoMaxRatio = 1.5;
+
+struct WindowStatistics {
+  Eigen::Vector3d mean_gyro = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mean_accel = Eigen::Vector3d::Zero();  // raw units
+  Eigen::Matrix3d cov_gyro = Eigen::Matrix3d::Zero();    // sample covariance
+  Eigen::Matrix3d cov_accel = Eigen::Matrix3d::Zero();   // raw units^2
+};
+
+// Two-pass mean and sample covariance (the window is small).
+WindowStatistics ComputeStatistics(const std::deque<ImuSample>& window) {
+  WindowStatistics s;
+  const double n = static_cast<double>(window.size());
+  for (const ImuSample& x : window) {
+    s.mean_gyro += x.angular_velocity_rad_s;
+    s.mean_accel += x.linear_acceleration;
+  }
+  s.mean_gyro /= n;
+  s.mean_accel /= n;
+  for (const ImuSample& x : window) {
+    const Eigen::Vector3d dg = x.angular_velocity_rad_s - s.mean_gyro;
+    const Eigen::Vector3d da = x.linear_acceleration - s.mean_accel;
+    s.cov_gyro += dg * dg.transpose();
+    s.cov_accel += da * da.transpose();
+  }
+  s.cov_gyro /= (n - 1.0);
+  s.cov_accel /= (n - 1.0);
+  return s;
+}
+
+}  // namespace
+
+std::string ImuInitializerOptions::Validate() const {
+  std::string error = config::ValidateFields(*this);
+  if (!error.empty()) return error;
+  if (acceleration_sign != 1 && acceleration_sign != -1) {
+    return "acceleration_sign: must be +1 or -1 (got " + std::to_string(acceleration_sign) + ")";
+  }
+  return {};
+}
+
+std::string ImuInitialization::Summary() const {
+  std::ostringstream os;
+  os << "IMU initialized from " << num_samples << " samples: acceleration unit "
+     << config::EnumToString(acceleration_unit) << (unit_detected ? " (detected)" : " (configured)")
+     << ", factor " << acceleration_to_m_s2 << ", |g| = " << gravity_magnitude_m_s2
+     << " m/s^2, g_in_G = [" << state.g_in_G.transpose() << "], gyro bias = ["
+     << state.gyro_bias.transpose() << "] rad/s, std gyro " << gyro_stddev_rad_s
+     << " rad/s, std acc " << accel_stddev_m_s2 << " m/s^2";
+  return os.str();
+}
+
+Status ImuInitializer::Create(const ImuInitializerOptions& options,
+                              std::unique_ptr<ImuInitializer>* initializer) {
+  const std::string error = options.Validate();
+  if (!error.empty()) return Status::InvalidArgument("imu initializer options: " + error);
+  initializer->reset(new ImuInitializer(options));
+  return Status::Ok();
+}
+
+int64_t ImuInitializer::DurationNs() const {
+  return static_cast<int64_t>(std::llround(options_.window_duration_s * 1e9));
+}
+
+Status ImuInitializer::AddSample(const ImuSample& sample) {
+  if (!IsFinite(sample)) {
+    ++num_rejected_non_finite_;
+    return Status::InvalidArgument("imu initializer: non-finite IMU sample at stamp " +
+                                   std::to_string(sample.stamp_ns) + " ns rejected");
+  }
+  if (!window_.empty() && sample.stamp_ns <= window_.back().stamp_ns) {
+    ++num_skipped_out_of_order_;
+    return Status::Ok();
+  }
+  window_.push_back(sample);
+  if (options_.window_duration_s > 0.0) {
+    // Keep the shortest suffix that still spans the duration.
+    const int64_t span_ns = DurationNs();
+    while (window_.size() > 2 && window_.back().stamp_ns - window_[1].stamp_ns >= span_ns) {
+      window_.pop_front();
+    }
+  } else {
+    while (static_cast<int>(window_.size()) > options_.window_num_samples) window_.pop_front();
+  }
+  return Status::Ok();
+}
+
+bool ImuInitializer::WindowFull() const {
+  if (window_.size() < 2) return false;
+  if (options_.window_duration_s > 0.0) {
+    return window_.back().stamp_ns - window_.front().stamp_ns >= DurationNs();
+  }
+  return static_cast<int>(window_.size()) >= options_.window_num_samples;
+}
+
+Status ImuInitializer::Initialize(ImuInitialization* result) const {
+  if (!WindowFull()) {
+    std::ostringstream os;
+    os << "imu initializer: window not full (" << window_.size() << " samples";
+    if (options_.window_duration_s > 0.0) {
+      os << ", need " << options_.window_duration_s << " s";
+    } else {
+      os << ", need " << options_.window_num_samples;
+    }
+    os << ")";
+    return Status::FailedPrecondition(os.str());
+  }
+  const WindowStatistics stats = ComputeStatistics(window_);
+  const double g0 = options_.nominal_gravity_m_s2;
+  const double raw_norm = stats.mean_accel.norm();
+
+  // 1. Unit: configured, or detected from |mean a_m| (~1 -> g, ~9.8 -> m/s^2).
+  AccelerationUnit unit = AccelerationUnit::kMetersPerSecondSquared;
+  bool detected = false;
+  switch (options_.acceleration_unit) {
+    case AccelerationUnitSetting::kMetersPerSecondSquared:
+      unit = AccelerationUnit::kMetersPerSecondSquared;
+      break;
+    case AccelerationUnitSetting::kStandardGravity:
+      unit = AccelerationUnit::kStandardGravity;
+      break;
+    case AccelerationUnitSetting::kAuto:
+      detected = true;
+      if (raw_norm >= kAutoMinRatio && raw_norm <= kAutoMaxRatio) {
+        unit = AccelerationUnit::kStandardGravity;
+      } else if (raw_norm >= kAutoMinRatio * g0 && raw_norm <= kAutoMaxRatio * g0) {
+        unit = AccelerationUnit::kMetersPerSecondSquared;
+      } else {
+        std::ostringstream os;
+        os << "imu initializer: cannot detect the acceleration unit: |mean acc| = " << raw_norm
+           << " is neither ~1 (g, accepted [" << kAutoMinRatio << ", " << kAutoMaxRatio
+           << "]) nor ~" << g0 << " (m/s^2, accepted [" << kAutoMinRatio * g0 << ", "
+           << kAutoMaxRatio * g0 << "])";
+        return Status::FailedPrecondition(os.str());
+      }
+      break;
+  }
+  const double unit_factor = unit == AccelerationUnit::kStandardGravity ? g0 : 1.0;
+  const double factor = options_.acceleration_sign * unit_factor;
+
+  // 2. Static test on the window (standard deviations in SI units).
+  const double gyro_std = std::sqrt(stats.cov_gyro.trace());
+  const double accel_std = unit_factor * std::sqrt(stats.cov_accel.trace());
+  const double gyro_mean_norm = stats.mean_gyro.norm();
+  if (!(gyro_std <= options_.max_gyro_stddev_rad_s) ||
+      !(accel_std <= options_.max_accel_stddev_m_s2) ||
+      !(gyro_mean_norm <= options_.max_gyro_bias_rad_s)) {
+    std::ostringstream os;
+    os << "imu initializer: the start is not static enough over " << window_.size()
+       << " samples: gyro std " << gyro_std << " rad/s (max " << options_.max_gyro_stddev_rad_s
+       << "), acc std " << accel_std << " m/s^2 (max " << options_.max_accel_stddev_m_s2
+       << "), |mean gyro| " << gyro_mean_norm << " rad/s (max " << options_.max_gyro_bias_rad_s
+       << "); keep the IMU still during initialization";
+    return Status::FailedPrecondition(os.str());
+  }
+
+  // 3. Gravity magnitude must match the unit (catches a wrong unit setting).
+  const double g_norm = unit_factor * raw_norm;
+  if (!(std::abs(g_norm / g0 - 1.0) <= options_.max_gravity_error_ratio)) {
+    std::ostringstream os;
+    os << "imu initializer: measured |g| = " << g_norm << " m/s^2 with acceleration unit "
+       << config::EnumToString(unit) << " is not within " << options_.max_gravity_error_ratio * 100
+       << " % of " << g0 << " m/s^2 (raw |mean acc| = " << raw_norm
+       << "); check acceleration_unit (m_s2, g or auto)";
+    return Status::FailedPrecondition(os.str());
+  }
+
+  // 4. State. G := the IMU frame at the last window sample.
+  const double n = static_cast<double>(window_.size());
+  ImuInitialization& r = *result;
+  r = ImuInitialization();
+  r.stamp_ns = window_.back().stamp_ns;
+  r.last_sample = window_.back();
+  r.state = EgoState();
+  r.state.gyro_bias = stats.mean_gyro;
+  r.state.accel_bias.setZero();
+  r.state.g_in_G = -factor * stats.mean_accel;
+  r.acceleration_unit = unit;
+  r.unit_detected = detected;
+  r.acceleration_to_m_s2 = factor;
+  r.gravity_magnitude_m_s2 = g_norm;
+  r.num_samples = static_cast<int>(window_.size());
+  r.gyro_stddev_rad_s = gyro_std;
+  r.accel_stddev_m_s2 = accel_std;
+
+  // 5. Covariance (docs/imu.md): pose/velocity floors, standard error of the
+  // gyro mean, the b_a prior, and gravity = -b_a + noise of the acc mean
+  // (a_m = -R^T g + b_a at rest, R = I), hence Cov(g, b_a) = -Cov(b_a).
+  auto& P = r.covariance;
+  P.setZero();
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const double sr = options_.initial_rotation_stddev_rad;
+  const double sp = options_.initial_position_stddev_m;
+  const double sv = options_.initial_velocity_stddev_m_s;
+  const double sbg = options_.gyro_bias_stddev_floor_rad_s;
+  const double sba = options_.initial_accel_bias_stddev_m_s2;
+  const double sg = options_.gravity_stddev_floor_m_s2;
+  P.block<3, 3>(L::kRotation.offset, L::kRotation.offset) = sr * sr * I;
+  P.block<3, 3>(L::kPosition.offset, L::kPosition.offset) = sp * sp * I;
+  P.block<3, 3>(L::kVelocity.offset, L::kVelocity.offset) = sv * sv * I;
+  P.block<3, 3>(L::kGyroBias.offset, L::kGyroBias.offset) = stats.cov_gyro / n + sbg * sbg * I;
+  P.block<3, 3>(L::kAccelBias.offset, L::kAccelBias.offset) = sba * sba * I;
+  P.block<3, 3>(L::kGravity.offset, L::kGravity.offset) =
+      sba * sba * I + unit_factor * unit_factor * stats.cov_accel / n + sg * sg * I;
+  P.block<3, 3>(L::kGravity.offset, L::kAccelBias.offset) = -sba * sba * I;
+  P.block<3, 3>(L::kAccelBias.offset, L::kGravity.offset) = -sba * sba * I;
+  return Status::Ok();
+}
+
+}  // namespace swarmlio

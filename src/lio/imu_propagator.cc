@@ -1,0 +1,317 @@
+#include "swarmlio/lio/imu_propagator.h"
+
+#include <sstream>
+
+#include "swarmlio/common/check.h"
+#include "swarmlio/lio/imu_initializer.h"
+#include "swarmlio/math/so3.h"
+
+namespace swarmlio {
+namespace {
+
+using L = ErrorStateLayout;
+using N = ImuNoiseLayout;
+
+// 3x3 block (rows of segment r, columns of segment c).
+template <class M>
+auto Block(M& m, const Segment& r, const Segment& c) {
+  return m.template block<3, 3>(r.offset, c.offset);
+}
+
+// The quantities of one interval that the state, the Jacobians and the
+// recorded scan poses share (docs/imu.md, "Discrete model").
+struct Interval {
+  Eigen::Vector3d w;         // unbiased angular rate [rad/s]
+  Eigen::Vector3d a;         // unbiased specific force [m/s^2]
+  Eigen::Vector3d phi;       // w dt [rad]
+  Eigen::Matrix3d R;         // R_G_b at the interval start
+  Eigen::Matrix3d M;         // Exp(phi / 2)
+  Eigen::Vector3d acc_in_G;  // R M a + g [m/s^2]
+};
+
+Interval MakeInterval(const EgoState& x,
+                      const ImuInput& u,
+                      double dt,
+                      const ImuNoiseVector& noise) {
+  Interval k;
+  k.w = u.angular_velocity_rad_s - x.gyro_bias - noise.segment<3>(N::kGyro.offset);
+  k.a = u.specific_force_m_s2 - x.accel_bias - noise.segment<3>(N::kAccel.offset);
+  k.phi = k.w * dt;
+  k.R = x.R_G_b();
+  k.M = so3::Exp(0.5 * k.phi);
+  k.acc_in_G = k.R * (k.M * k.a) + x.g_in_G;
+  return k;
+}
+
+}  // namespace
+
+ImuInput ToImuInput(const ImuSample& sample, double acceleration_to_m_s2) {
+  ImuInput u;
+  u.angular_velocity_rad_s = sample.angular_velocity_rad_s;
+  u.specific_force_m_s2 = acceleration_to_m_s2 * sample.linear_acceleration;
+  return u;
+}
+
+EgoState PropagateEgo(const EgoState& x, const ImuInput& u, double dt_s, const ImuNoiseVector& w) {
+  const Interval k = MakeInterval(x, u, dt_s, w);
+  EgoState y = x;
+  y.q_G_b = (x.q_G_b * so3::ExpQuaternion(k.phi)).normalized();
+  y.p_b_in_G = x.p_b_in_G + x.v_b_in_G * dt_s + 0.5 * dt_s * dt_s * k.acc_in_G;
+  y.v_b_in_G = x.v_b_in_G + k.acc_in_G * dt_s;
+  y.gyro_bias = x.gyro_bias + w.segment<3>(N::kGyroBiasWalk.offset) * dt_s;
+  y.accel_bias = x.accel_bias + w.segment<3>(N::kAccelBiasWalk.offset) * dt_s;
+  y.g_in_G = x.g_in_G;
+  return y;
+}
+
+void EgoProcessJacobians(
+    const EgoState& x, const ImuInput& u, double dt_s, EgoMatrix* F_out, EgoNoiseMatrix* G_out) {
+  const Interval k = MakeInterval(x, u, dt_s, ImuNoiseVector::Zero());
+  const double dt = dt_s;
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d RM = k.R * k.M;
+  // Partial derivatives of a_G = R Exp(phi/2) a + g (right perturbations):
+  const Eigen::Matrix3d dacc_dtheta = -k.R * so3::Hat(k.M * k.a);
+  // d a_G / d phi = -1/2 R M [a]x Jr(phi/2), and d phi / d b_g = -dt I.
+  const Eigen::Matrix3d dacc_dbg = 0.5 * dt * RM * so3::Hat(k.a) * so3::RightJacobian(0.5 * k.phi);
+  const Eigen::Matrix3d dacc_dba = -RM;
+  const Eigen::Matrix3d dtheta_dbg = -so3::RightJacobian(k.phi) * dt;
+  const double half_dt2 = 0.5 * dt * dt;
+
+  EgoMatrix& F = *F_out;
+  F.setIdentity();
+  Block(F, L::kRotation, L::kRotation) = so3::Exp(-k.phi);
+  Block(F, L::kRotation, L::kGyroBias) = dtheta_dbg;
+  Block(F, L::kPosition, L::kRotation) = half_dt2 * dacc_dtheta;
+  Block(F, L::kPosition, L::kVelocity) = dt * I;
+  Block(F, L::kPosition, L::kGyroBias) = half_dt2 * dacc_dbg;
+  Block(F, L::kPosition, L::kAccelBias) = half_dt2 * dacc_dba;
+  Block(F, L::kPosition, L::kGravity) = half_dt2 * I;
+  Block(F, L::kVelocity, L::kRotation) = dt * dacc_dtheta;
+  Block(F, L::kVelocity, L::kGyroBias) = dt * dacc_dbg;
+  Block(F, L::kVelocity, L::kAccelBias) = dt * dacc_dba;
+  Block(F, L::kVelocity, L::kGravity) = dt * I;
+
+  // n_g and n_a enter exactly like b_g and b_a.
+  EgoNoiseMatrix& G = *G_out;
+  G.setZero();
+  Block(G, L::kRotation, N::kGyro) = dtheta_dbg;
+  Block(G, L::kPosition, N::kGyro) = half_dt2 * dacc_dbg;
+  Block(G, L::kPosition, N::kAccel) = half_dt2 * dacc_dba;
+  Block(G, L::kVelocity, N::kGyro) = dt * dacc_dbg;
+  Block(G, L::kVelocity, N::kAccel) = dt * dacc_dba;
+  Block(G, L::kGyroBias, N::kGyroBiasWalk) = dt * I;
+  Block(G, L::kAccelBias, N::kAccelBiasWalk) = dt * I;
+}
+
+Eigen::Matrix<double, ImuNoiseLayout::kDim, ImuNoiseLayout::kDim> EgoNoiseCovariance(
+    const ProcessNoiseOptions& noise) {
+  Eigen::Matrix<double, N::kDim, N::kDim> Q = Eigen::Matrix<double, N::kDim, N::kDim>::Zero();
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  Block(Q, N::kGyro, N::kGyro) = noise.gyro_cov_rad2_s2 * I;
+  Block(Q, N::kAccel, N::kAccel) = noise.accel_cov_m2_s4 * I;
+  Block(Q, N::kGyroBiasWalk, N::kGyroBiasWalk) = noise.gyro_bias_cov_rad2_s4 * I;
+  Block(Q, N::kAccelBiasWalk, N::kAccelBiasWalk) = noise.accel_bias_cov_m2_s6 * I;
+  return Q;
+}
+
+Status ImuPropagator::Create(const ImuPropagatorOptions& options,
+                             std::unique_ptr<ImuPropagator>* propagator) {
+  const std::string error = options.Validate();
+  if (!error.empty()) return Status::InvalidArgument("imu propagator options: " + error);
+  propagator->reset(new ImuPropagator(options));
+  return Status::Ok();
+}
+
+Status ImuPropagator::Reset(const SwarmState& state,
+                            const Eigen::MatrixXd& P,
+                            const ImuSample& sample,
+                            double acceleration_to_m_s2) {
+  if (P.rows() != state.Dim() || P.cols() != state.Dim()) {
+    std::ostringstream os;
+    os << "imu propagator: covariance is " << P.rows() << "x" << P.cols() << ", state dim is "
+       << state.Dim();
+    return Status::InvalidArgument(os.str());
+  }
+  const ImuInput u = ToImuInput(sample, acceleration_to_m_s2);
+  if (!u.angular_velocity_rad_s.allFinite() || !u.specific_force_m_s2.allFinite() ||
+      !P.allFinite()) {
+    return Status::InvalidArgument("imu propagator: non-finite initial sample or covariance");
+  }
+  state_ = state;
+  P_ = P;
+  stamp_ns_ = sample.stamp_ns;
+  last_sample_stamp_ns_ = sample.stamp_ns;
+  last_input_ = u;
+  acceleration_to_m_s2_ = acceleration_to_m_s2;
+  initialized_ = true;
+  StartScan();
+  return Status::Ok();
+}
+
+Status ImuPropagator::Reset(const ImuInitialization& init) {
+  SwarmState state;
+  state.ego = init.state;
+  return Reset(state, Eigen::MatrixXd(init.covariance), init.last_sample,
+               init.acceleration_to_m_s2);
+}
+
+Status ImuPropagator::CheckGap(int64_t stamp_ns) const {
+  const double dt = StampSeconds(stamp_ns - stamp_ns_);
+  if (dt <= options_.max_gap_s) return Status::Ok();
+  std::ostringstream os;
+  os << "imu propagator: gap of " << dt << " s from " << stamp_ns_ << " ns to " << stamp_ns
+     << " ns exceeds max_gap_s = " << options_.max_gap_s << " s; not propagated (re-initialize)";
+  return Status::OutOfRange(os.str());
+}
+
+Status ImuPropagator::AddImu(const ImuSample& sample) {
+  CHECK(initialized_) << "ImuPropagator::AddImu before Reset";
+  const ImuInput u = ToImuInput(sample, acceleration_to_m_s2_);
+  if (!u.angular_velocity_rad_s.allFinite() || !u.specific_force_m_s2.allFinite()) {
+    ++num_rejected_non_finite_;
+    return Status::InvalidArgument("imu propagator: non-finite IMU sample at stamp " +
+                                   std::to_string(sample.stamp_ns) + " ns rejected");
+  }
+  if (sample.stamp_ns == last_sample_stamp_ns_) {
+    ++num_skipped_duplicate_;
+    return Status::Ok();
+  }
+  if (sample.stamp_ns == stamp_ns_ && sample.stamp_ns > last_sample_stamp_ns_) {
+    // PropagateTo() already reached this stamp: the sample only becomes the
+    // input from here on.
+    last_input_ = u;
+    last_sample_stamp_ns_ = sample.stamp_ns;
+    scan_poses_.back() = CurrentPose(u);
+    return Status::Ok();
+  }
+  if (sample.stamp_ns <= stamp_ns_) {
+    ++num_skipped_out_of_order_;
+    return Status::Ok();
+  }
+  const Status gap = CheckGap(sample.stamp_ns);
+  if (!gap.ok()) {
+    ++num_gaps_;
+    return gap;
+  }
+  // Input at the midpoint time of [stamp_ns_, sample], linearly interpolated
+  // between the previous sample and this one (the plain mean of the two when
+  // the state sits on the previous sample).
+  const ImuInput mid = MidpointInput(u, sample.stamp_ns, sample.stamp_ns);
+  Step(mid, StampSeconds(sample.stamp_ns - stamp_ns_), sample.stamp_ns);
+  last_input_ = u;
+  last_sample_stamp_ns_ = sample.stamp_ns;
+  // The new pose's held input is the sample itself until the next step.
+  scan_poses_.back() = CurrentPose(u);
+  return Status::Ok();
+}
+
+Status ImuPropagator::PropagateTo(int64_t stamp_ns, const ImuSample* next_sample) {
+  CHECK(initialized_) << "ImuPropagator::PropagateTo before Reset";
+  if (stamp_ns == stamp_ns_) return Status::Ok();
+  if (stamp_ns < stamp_ns_) {
+    std::ostringstream os;
+    os << "imu propagator: cannot propagate back in time from " << stamp_ns_ << " ns to "
+       << stamp_ns << " ns";
+    return Status::OutOfRange(os.str());
+  }
+  ImuInput u = last_input_;  // zero-order hold
+  if (next_sample != nullptr) {
+    const ImuInput next = ToImuInput(*next_sample, acceleration_to_m_s2_);
+    if (next_sample->stamp_ns < stamp_ns || !next.angular_velocity_rad_s.allFinite() ||
+        !next.specific_force_m_s2.allFinite()) {
+      std::ostringstream os;
+      os << "imu propagator: next sample (stamp " << next_sample->stamp_ns
+         << " ns) must be finite and not before the target " << stamp_ns << " ns";
+      return Status::InvalidArgument(os.str());
+    }
+    u = MidpointInput(next, next_sample->stamp_ns, stamp_ns);
+  }
+  const Status gap = CheckGap(stamp_ns);
+  if (!gap.ok()) {
+    ++num_gaps_;
+    return gap;
+  }
+  Step(u, StampSeconds(stamp_ns - stamp_ns_), stamp_ns);
+  return Status::Ok();
+}
+
+ImuInput ImuPropagator::MidpointInput(const ImuInput& next,
+                                      int64_t next_stamp_ns,
+                                      int64_t end_ns) const {
+  const double span_s = StampSeconds(next_stamp_ns - last_sample_stamp_ns_);
+  const double t_mid_s = 0.5 * (StampSeconds(stamp_ns_ - last_sample_stamp_ns_) +
+                                StampSeconds(end_ns - last_sample_stamp_ns_));
+  const double alpha = span_s > 0.0 ? t_mid_s / span_s : 0.0;
+  ImuInput mid;
+  mid.angular_velocity_rad_s =
+      last_input_.angular_velocity_rad_s +
+      alpha * (next.angular_velocity_rad_s - last_input_.angular_velocity_rad_s);
+  mid.specific_force_m_s2 = last_input_.specific_force_m_s2 +
+                            alpha * (next.specific_force_m_s2 - last_input_.specific_force_m_s2);
+  return mid;
+}
+
+void ImuPropagator::StartScan() {
+  scan_poses_.clear();
+  scan_poses_.push_back(CurrentPose(last_input_));
+}
+
+void ImuPropagator::SetState(const SwarmState& state, const Eigen::MatrixXd& P) {
+  CHECK_EQ(P.rows(), state.Dim());
+  CHECK_EQ(P.cols(), state.Dim());
+  state_ = state;
+  P_ = P;
+  StartScan();
+}
+
+ImuPose ImuPropagator::CurrentPose(const ImuInput& u) const {
+  const EgoState& x = state_.ego;
+  ImuPose pose;
+  pose.stamp_ns = stamp_ns_;
+  pose.R_G_b = x.R_G_b();
+  pose.p_b_in_G = x.p_b_in_G;
+  pose.v_b_in_G = x.v_b_in_G;
+  pose.angular_velocity_in_b_rad_s = u.angular_velocity_rad_s - x.gyro_bias;
+  pose.acc_in_G_m_s2 = pose.R_G_b * (u.specific_force_m_s2 - x.accel_bias) + x.g_in_G;
+  return pose;
+}
+
+void ImuPropagator::Step(const ImuInput& u, double dt_s, int64_t stamp_ns) {
+  EgoMatrix F;
+  EgoNoiseMatrix G;
+  EgoProcessJacobians(state_.ego, u, dt_s, &F, &G);
+  // The pose that starts this interval holds exactly the input integrated.
+  const Interval k = MakeInterval(state_.ego, u, dt_s, ImuNoiseVector::Zero());
+  scan_poses_.back().angular_velocity_in_b_rad_s = k.w;
+  scan_poses_.back().acc_in_G_m_s2 = k.acc_in_G;
+
+  state_.ego = PropagateEgo(state_.ego, u, dt_s);
+  PropagateCovariance(F, G, dt_s);
+  stamp_ns_ = stamp_ns;
+  scan_poses_.push_back(CurrentPose(u));
+}
+
+void ImuPropagator::PropagateCovariance(const EgoMatrix& F, const EgoNoiseMatrix& G, double dt_s) {
+  constexpr int kEgo = L::kEgoDim;
+  // F = diag(F_ego, I): only the ego rows and columns change.
+  const Eigen::MatrixXd top = F * P_.topRows(kEgo);
+  P_.topRows(kEgo) = top;
+  const Eigen::MatrixXd left = P_.leftCols(kEgo) * F.transpose();
+  P_.leftCols(kEgo) = left;
+  const auto Q = EgoNoiseCovariance(options_.process_noise);
+  P_.topLeftCorner(kEgo, kEgo) += G * Q * G.transpose();
+  // Teammate random walks: R Exp(n_R dt), p + n_p dt.
+  const double dt2 = dt_s * dt_s;
+  for (int id : state_.layout().teammate_ids()) {
+    const Segment rot = state_.layout().TeammateRotation(id);
+    const Segment trans = state_.layout().TeammateTranslation(id);
+    P_.block<3, 3>(rot.offset, rot.offset).diagonal().array() +=
+        dt2 * options_.process_noise.teammate_rotation_cov_rad2_s2;
+    P_.block<3, 3>(trans.offset, trans.offset).diagonal().array() +=
+        dt2 * options_.process_noise.teammate_translation_cov_m2_s2;
+  }
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
+}
+
+}  // namespace swarmlio

@@ -1,0 +1,103 @@
+#include "swarmlio/lio/plane_fit.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "swarmlio/common/check.h"
+
+namespace swarmlio::lio {
+namespace {
+
+template <class GetPoint>
+PlaneFitStatus FitImpl(int n, const GetPoint& get, double farthest_sq_distance_m2,
+                       const PlaneFitOptions& options, Plane* plane) {
+  CHECK(plane != nullptr);
+  if (n < options.min_neighbors || n < 3) return PlaneFitStatus::kTooFewPoints;
+  if (!(farthest_sq_distance_m2 <= options.max_neighbor_sq_distance_m2)) {
+    return PlaneFitStatus::kNeighborsTooFar;
+  }
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) centroid += get(i);
+  centroid /= n;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d e = get(i) - centroid;
+    scatter.noalias() += e * e.transpose();
+  }
+  scatter /= n;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(scatter);  // eigenvalues ascending
+  const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0);
+  if (!(std::sqrt(lambda(1)) >= options.min_plane_extent_m) || !lambda.allFinite()) {
+    return PlaneFitStatus::kDegenerate;
+  }
+  Eigen::Vector3d normal = eig.eigenvectors().col(0).normalized();
+  double offset = -normal.dot(centroid);
+  bool flip = offset > 0.0;
+  if (offset == 0.0) {
+    for (int i = 0; i < 3; ++i) {
+      if (normal(i) != 0.0) {
+        flip = normal(i) < 0.0;
+        break;
+      }
+    }
+  }
+  if (flip) {
+    normal = -normal;
+    offset = -offset;
+  }
+  double max_abs = 0.0;
+  double sum_sq = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double r = normal.dot(get(i)) + offset;
+    max_abs = std::max(max_abs, std::abs(r));
+    sum_sq += r * r;
+  }
+  if (!(max_abs <= options.max_point_to_plane_m)) return PlaneFitStatus::kNotPlanar;
+  plane->normal_in_G = normal;
+  plane->offset_m = offset;
+  plane->max_abs_residual_m = max_abs;
+  plane->rms_residual_m = std::sqrt(sum_sq / n);
+  const double sum = lambda.sum();
+  plane->curvature = sum > 0.0 ? lambda(0) / sum : 0.0;
+  return PlaneFitStatus::kOk;
+}
+
+}  // namespace
+
+const char* ToString(PlaneFitStatus status) {
+  switch (status) {
+    case PlaneFitStatus::kOk:
+      return "ok";
+    case PlaneFitStatus::kTooFewPoints:
+      return "too_few_points";
+    case PlaneFitStatus::kNeighborsTooFar:
+      return "neighbors_too_far";
+    case PlaneFitStatus::kDegenerate:
+      return "degenerate";
+    case PlaneFitStatus::kNotPlanar:
+      return "not_planar";
+  }
+  return "?";
+}
+
+PlaneFitStatus FitPlane(const std::vector<Eigen::Vector3d>& points,
+                        double farthest_sq_distance_m2, const PlaneFitOptions& options,
+                        Plane* plane) {
+  return FitImpl(
+      static_cast<int>(points.size()), [&](int i) -> const Eigen::Vector3d& { return points[i]; },
+      farthest_sq_distance_m2, options, plane);
+}
+
+PlaneFitStatus FitPlane(const std::vector<Neighbor>& neighbors, const PlaneFitOptions& options,
+                        Plane* plane) {
+  double farthest = 0.0;
+  for (const Neighbor& nb : neighbors) farthest = std::max(farthest, nb.squared_distance_m2);
+  return FitImpl(
+      static_cast<int>(neighbors.size()),
+      [&](int i) -> const Eigen::Vector3d& { return neighbors[i].point_in_G; }, farthest, options,
+      plane);
+}
+
+}  // namespace swarmlio::lio
