@@ -54,29 +54,6 @@ class Sampler {
   std::normal_distribution<double> n_;
 };
 
-// Flips the sign of the rotation columns (see prior_factor_test.cc).
-class FlippedRotationSign final : public ceres::CostFunction {
- public:
-  explicit FlippedRotationSign(const ceres::CostFunction* inner) : inner_(inner) {
-    set_num_residuals(inner->num_residuals());
-    *mutable_parameter_block_sizes() = inner->parameter_block_sizes();
-  }
-  bool Evaluate(double const* const* parameters,
-                double* residuals,
-                double** jacobians) const override {
-    if (!inner_->Evaluate(parameters, residuals, jacobians)) return false;
-    if (jacobians != nullptr && jacobians[0] != nullptr) {
-      for (int r = 0; r < num_residuals(); ++r) {
-        for (int c = 0; c < 4; ++c) jacobians[0][r * 19 + c] *= -1.0;
-      }
-    }
-    return true;
-  }
-
- private:
-  const ceres::CostFunction* inner_;
-};
-
 TEST(PointToPlaneFactor, ResidualIsEquationFour) {
   Sampler s(1);
   std::vector<Eigen::Vector3d> q;
@@ -118,7 +95,7 @@ TEST(PointToPlaneFactor, FlippedSignIsRejected) {
   std::vector<Eigen::Vector3d> q;
   const std::vector<PlaneCorrespondence> corr = s.Correspondences(30, &q);
   const PointToPlaneFactor factor(&corr);
-  const FlippedRotationSign flipped(&factor);
+  const testing::FlippedJacobianColumns flipped(&factor, /*block=*/0, /*num_columns=*/4);
   EgoStateManifold manifold;
   std::array<double, 19> x;
   s.Ego(-1.0).ToParameters(x.data());

@@ -81,31 +81,6 @@ struct Blocks {
   std::vector<const double*> pointers;
 };
 
-// Delegates to a cost function and flips the sign of the ego rotation
-// columns of its Jacobian: the checker must reject it.
-class FlippedRotationSign final : public ceres::CostFunction {
- public:
-  explicit FlippedRotationSign(const ceres::CostFunction* inner) : inner_(inner) {
-    set_num_residuals(inner->num_residuals());
-    *mutable_parameter_block_sizes() = inner->parameter_block_sizes();
-  }
-  bool Evaluate(double const* const* parameters,
-                double* residuals,
-                double** jacobians) const override {
-    if (!inner_->Evaluate(parameters, residuals, jacobians)) return false;
-    if (jacobians != nullptr && jacobians[0] != nullptr) {
-      const int cols = parameter_block_sizes()[0];
-      for (int r = 0; r < num_residuals(); ++r) {
-        for (int c = 0; c < 4; ++c) jacobians[0][r * cols + c] *= -1.0;
-      }
-    }
-    return true;
-  }
-
- private:
-  const ceres::CostFunction* inner_;
-};
-
 std::unique_ptr<PriorFactor> MakePrior(const SwarmState& x_hat, const Eigen::MatrixXd& P) {
   Eigen::MatrixXd U;
   EXPECT_TRUE(PriorFactor::CholeskyOfCovariance(P, &U));
@@ -247,7 +222,7 @@ TEST(PriorFactor, FlippedSignIsRejected) {
   const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim()));
   const SwarmState x = x_hat.BoxPlus(s.Gaussian(x_hat.Dim(), 0.5));
   Blocks blocks(x);
-  const FlippedRotationSign flipped(prior.get());
+  const testing::FlippedJacobianColumns flipped(prior.get(), /*block=*/0, /*num_columns=*/4);
   EXPECT_FALSE(
       testing::CostFunctionJacobiansAreCorrect(flipped, blocks.manifolds, blocks.pointers));
 }

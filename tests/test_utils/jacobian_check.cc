@@ -33,6 +33,25 @@ namespace swarmlio::testing {
                                        << results.error_log;
 }
 
+FlippedJacobianColumns::FlippedJacobianColumns(const ceres::CostFunction* inner, int block,
+                                               int num_columns)
+    : inner_(inner), block_(block), num_columns_(num_columns) {
+  set_num_residuals(inner->num_residuals());
+  *mutable_parameter_block_sizes() = inner->parameter_block_sizes();
+}
+
+bool FlippedJacobianColumns::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  if (!inner_->Evaluate(parameters, residuals, jacobians)) return false;
+  if (jacobians != nullptr && jacobians[block_] != nullptr) {
+    const int cols = parameter_block_sizes()[block_];
+    for (int r = 0; r < num_residuals(); ++r) {
+      for (int col = 0; col < num_columns_; ++col) jacobians[block_][r * cols + col] *= -1.0;
+    }
+  }
+  return true;
+}
+
 Eigen::MatrixXd NumericJacobian(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
                                 int n, double step) {
   const Eigen::VectorXd f0 = f(Eigen::VectorXd::Zero(n));

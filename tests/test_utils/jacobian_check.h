@@ -24,6 +24,22 @@ namespace swarmlio::testing {
     const std::vector<const double*>& parameters,
     double relative_tolerance = 1e-7);
 
+/// Delegates to a cost function and flips the sign of the first
+/// `num_columns` ambient columns of parameter block `block` in its Jacobian
+/// (e.g. the 4 quaternion columns of the rotation): a Jacobian check must
+/// reject the result. Used to prove that a check fails on a flipped sign.
+class FlippedJacobianColumns final : public ceres::CostFunction {
+ public:
+  FlippedJacobianColumns(const ceres::CostFunction* inner, int block, int num_columns);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const ceres::CostFunction* inner_;
+  int block_;
+  int num_columns_;
+};
+
 /// Central-difference Jacobian of f: R^n -> R^m at dx = 0, where f is already
 /// written in tangent coordinates (e.g. f(dx) = g(x (+) dx) (-) g(x)).
 Eigen::MatrixXd NumericJacobian(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,

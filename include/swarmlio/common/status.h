@@ -1,7 +1,7 @@
 // Status: the error value returned across module boundaries.
 //
 // Library code never throws across a module boundary, never prints and never
-// calls exit(). A function that can fail on bad input (a file, a packet, a
+// ends the process. A function that can fail on bad input (a file, a packet, a
 // config value) returns a Status; programmer errors are CHECKs (see check.h).
 #pragma once
 
