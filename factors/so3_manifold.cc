@@ -7,20 +7,16 @@
 namespace swarmlio {
 namespace {
 
-Eigen::Quaterniond Read(const double* x) { return Eigen::Quaterniond(x[3], x[0], x[1], x[2]); }
-
-void Write(const Eigen::Quaterniond& q, double* x) {
-  x[0] = q.x();
-  x[1] = q.y();
-  x[2] = q.z();
-  x[3] = q.w();
-}
+// Eigen's quaternion coefficient order is (x, y, z, w), the ambient layout.
+using ConstQuaternionMap = Eigen::Map<const Eigen::Quaterniond>;
+using QuaternionMap = Eigen::Map<Eigen::Quaterniond>;
 
 }  // namespace
 
 bool SO3Manifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
   const Eigen::Map<const Eigen::Vector3d> dr(delta);
-  Write((Read(x) * so3::ExpQuaternion(dr)).normalized(), x_plus_delta);
+  QuaternionMap out(x_plus_delta);
+  out = (ConstQuaternionMap(x) * so3::ExpQuaternion(dr)).normalized();
   return true;
 }
 
@@ -35,7 +31,7 @@ bool SO3Manifold::PlusJacobian(const double* x, double* jacobian) const {
 
 bool SO3Manifold::Minus(const double* y, const double* x, double* y_minus_x) const {
   Eigen::Map<Eigen::Vector3d> out(y_minus_x);
-  out = so3::LogQuaternionNoWrap(Read(x).conjugate() * Read(y));
+  out = so3::LogQuaternionNoWrap(ConstQuaternionMap(x).conjugate() * ConstQuaternionMap(y));
   return true;
 }
 

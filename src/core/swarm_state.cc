@@ -16,15 +16,14 @@ constexpr int kEgoBg = 10;
 constexpr int kEgoBa = 13;
 constexpr int kEgoGrav = 16;
 
+// Eigen's quaternion coefficient order (x, y, z, w) is the ambient layout.
 void WriteQuaternion(const Eigen::Quaterniond& q, double* x) {
-  x[0] = q.x();
-  x[1] = q.y();
-  x[2] = q.z();
-  x[3] = q.w();
+  Eigen::Map<Eigen::Quaterniond> out(x);
+  out = q;
 }
 
 Eigen::Quaterniond ReadQuaternion(const double* x) {
-  return Eigen::Quaterniond(x[3], x[0], x[1], x[2]);
+  return Eigen::Quaterniond(Eigen::Map<const Eigen::Quaterniond>(x));
 }
 
 // q (+) dr = q Exp(dr), renormalised against round-off drift.
