@@ -115,21 +115,13 @@ bool PosteriorCovariance(const PriorFactor& prior,
 
 }  // namespace
 
-Status EsikfUpdateOptions::Validate() const {
-  if (max_iterations < 1) {
-    return Status::InvalidArgument("EsikfUpdateOptions.max_iterations must be >= 1");
-  }
-  if (!(convergence_rotation_rad > 0.0)) {
-    return Status::InvalidArgument("EsikfUpdateOptions.convergence_rotation_rad must be > 0 [rad]");
-  }
-  if (!(convergence_translation_m > 0.0)) {
-    return Status::InvalidArgument("EsikfUpdateOptions.convergence_translation_m must be > 0 [m]");
-  }
+std::string EsikfUpdateOptions::Validate() const {
+  const std::string fields = config::ValidateFields(*this);
+  if (!fields.empty()) return fields;
   if (linear_solver != ceres::DENSE_NORMAL_CHOLESKY && linear_solver != ceres::DENSE_QR) {
-    return Status::InvalidArgument(
-        "EsikfUpdateOptions.linear_solver must be DENSE_NORMAL_CHOLESKY or DENSE_QR");
+    return "linear_solver: must be DENSE_NORMAL_CHOLESKY or DENSE_QR";
   }
-  return Status::Ok();
+  return "";
 }
 
 EsikfUpdate::EsikfUpdate(EsikfUpdateOptions options) : options_(std::move(options)) {}
@@ -153,7 +145,9 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat,
     result.total_time_s = SecondsSince(t_start);
     return result;
   };
-  if (Status valid = options_.Validate(); !valid.ok()) return fail(std::move(valid));
+  if (const std::string invalid = options_.Validate(); !invalid.empty()) {
+    return fail(Status::InvalidArgument("EsikfUpdateOptions." + invalid));
+  }
   if (x_start.layout() != x_hat.layout()) {
     return fail(Status::InvalidArgument("EsikfUpdate: x_start and x_hat have different layouts"));
   }

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "swarmlio/config/config_file.h"
+#include "swarmlio/config/sensor_preset.h"
 #include "swarmlio/sim/trajectory_builder.h"
 
 namespace swarmlio::sim {
@@ -326,7 +327,7 @@ Status LoadPresetSensors(const config::ConfigFile& file,
                          SimulatedImuOptions* imu) {
   *lidar = SimulatedLidarOptions();
   *imu = SimulatedImuOptions();
-  const Status status = LoadSensorPreset(path, &lidar->sensor, &imu->sensor);
+  const Status status = config::LoadSensorPreset(path, &lidar->sensor, &imu->sensor);
   return status.ok() ? status : file.KeyError(key, status.message());
 }
 
@@ -412,17 +413,6 @@ SimulationConfig Scenario::simulation_config() const {
   c.ground_truth_rate_hz = options.ground_truth_rate_hz;
   c.num_threads = options.num_threads;
   return c;
-}
-
-Status LoadSensorPreset(const std::string& path, LidarOptions* lidar, ImuOptions* imu) {
-  config::ConfigFile file;
-  SWARMLIO_RETURN_IF_ERROR(config::ConfigFile::Load(path, &file));
-  if (!file.HasSection("lidar") && !file.HasSection("imu")) {
-    return Status::InvalidArgument(path + ": not a sensor preset (no lidar or imu section)");
-  }
-  if (lidar != nullptr) SWARMLIO_RETURN_IF_ERROR(file.Read("lidar", lidar));
-  if (imu != nullptr) SWARMLIO_RETURN_IF_ERROR(file.Read("imu", imu));
-  return Status::Ok();
 }
 
 namespace {

@@ -150,19 +150,19 @@ EsikfUpdate OneStep(ceres::LinearSolverType solver = ceres::DENSE_NORMAL_CHOLESK
 }
 
 TEST(EsikfUpdateOptions, Validate) {
-  EXPECT_TRUE(EsikfUpdateOptions().Validate().ok());
+  EXPECT_EQ(EsikfUpdateOptions().Validate(), "");
   EsikfUpdateOptions o;
   o.max_iterations = 0;
-  EXPECT_FALSE(o.Validate().ok());
+  EXPECT_NE(o.Validate(), "");
   o = {};
   o.convergence_rotation_rad = 0.0;
-  EXPECT_FALSE(o.Validate().ok());
+  EXPECT_NE(o.Validate(), "");
   o = {};
   o.convergence_translation_m = -1.0;
-  EXPECT_NE(o.Validate().message().find("convergence_translation_m"), std::string::npos);
+  EXPECT_NE(o.Validate().find("convergence_translation_m"), std::string::npos);
   o = {};
   o.linear_solver = ceres::CGNR;
-  EXPECT_FALSE(o.Validate().ok());
+  EXPECT_NE(o.Validate(), "");
 }
 
 // Linear-Gaussian: points at the body origin (z = n^T p + d, linear in p) and

@@ -123,6 +123,37 @@ TEST(Undistortion, PointsReturnToTheirWorldPositions) {
   EXPECT_GT(max_err_raw, 0.5);
 }
 
+TEST(Undistortion, BodyFramePointsGiveTheSameResultAsTheScan) {
+  std::mt19937 rng(43);
+  const Helix helix;
+  const Extrinsic ext;
+  std::vector<Eigen::Vector3d> world;
+  const LidarScan scan = SyntheticScan(helix, ext, 500, rng, &world);
+  const std::vector<ImuPose> poses = PropagatedPoses(helix);
+  std::vector<UndistortedPoint> from_scan;
+  ASSERT_TRUE(UndistortScan(scan, poses, ext.R_imu_lidar, ext.p_lidar_in_imu, &from_scan).ok());
+  std::vector<lio::PointXYZT> in_b;
+  for (const LidarPoint& q : scan.points) {
+    lio::PointXYZT p;
+    p.p_in_b = ext.R_imu_lidar * Eigen::Vector3d(q.x, q.y, q.z) + ext.p_lidar_in_imu;
+    p.time_s = q.offset_time_s;
+    in_b.push_back(p);
+  }
+  lio::PointXYZT bad;
+  bad.p_in_b.x() = std::numeric_limits<double>::quiet_NaN();
+  in_b.push_back(bad);
+  std::vector<Eigen::Vector3d> out;
+  UndistortionStats stats;
+  ASSERT_TRUE(UndistortPoints(in_b, scan.stamp_ns, poses, &out, &stats).ok());
+  ASSERT_EQ(out.size(), from_scan.size());
+  EXPECT_EQ(stats.num_skipped_non_finite, 1);
+  for (size_t i = 0; i < out.size(); ++i) {
+    EXPECT_LT((out[i] - from_scan[i].p_in_b_end).norm(), 1e-12);
+  }
+  EXPECT_EQ(UndistortPoints(in_b, scan.stamp_ns, {}, &out).code(),
+            Status::Code::kFailedPrecondition);
+}
+
 TEST(Undistortion, BodyPoseAtMatchesThePosesAtTheirStamps) {
   const Helix helix;
   const std::vector<ImuPose> poses = PropagatedPoses(helix);

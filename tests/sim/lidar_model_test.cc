@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "swarmlio/config/sensor_preset.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/trajectory_builder.h"
 
@@ -45,7 +46,7 @@ Trajectory FastFlight(const Eigen::Vector3d& start, uint64_t seed, double speed 
 SimulatedLidarOptions Preset(const std::string& file) {
   SimulatedLidarOptions o;
   const Status status =
-      LoadSensorPreset(std::string(SWARMLIO_SOURCE_DIR) + "/configs/" + file, &o.sensor, nullptr);
+      config::LoadSensorPreset(std::string(SWARMLIO_SOURCE_DIR) + "/configs/" + file, &o.sensor, nullptr);
   EXPECT_TRUE(status.ok()) << status.message();
   return o;
 }

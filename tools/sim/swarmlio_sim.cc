@@ -1,7 +1,8 @@
 // swarmlio_sim: runs a scenario and writes, per drone, a ROS1 bag
 // (<name>.bag: /livox/lidar, /livox/imu, /ground_truth/pose), a TUM ground
 // truth file in the drone's global frame (<name>_gt_tum.txt), and the resolved
-// scenario (resolved_scenario.yaml: T_W_Gi, extrinsics, noise settings).
+// scenario (resolved_scenario.yaml: T_W_Gi, extrinsics, noise settings) and
+// the replay manifest (swarm.yaml) for swarmlio_replay.
 //
 //   swarmlio_sim --scenario=configs/scenarios/indoor_3uav.yaml --output_dir=out
 #include <gflags/gflags.h>
@@ -33,6 +34,13 @@ std::string Vec(const Eigen::Vector3d& v) {
   return os.str();
 }
 
+std::string Indented(const std::string& block, const std::string& indent) {
+  std::ostringstream os;
+  std::istringstream lines(block);
+  for (std::string line; std::getline(lines, line);) os << indent << line << "\n";
+  return os.str();
+}
+
 std::string Resolved(const Scenario& s, const Simulator& sim) {
   std::ostringstream os;
   os << std::setprecision(17);
@@ -55,8 +63,29 @@ std::string Resolved(const Scenario& s, const Simulator& sim) {
     os << "    clock_offset_s: " << d.clock_offset_s << "\n";
     std::string block = config::DumpOptions(d.lidar, "lidar") + config::DumpOptions(d.imu, "imu") +
                         config::DumpOptions(d.body, "body");
-    std::istringstream lines(block);
-    for (std::string line; std::getline(lines, line);) os << "    " << line << "\n";
+    os << Indented(block, "    ");
+  }
+  return os.str();
+}
+
+// The replay manifest (docs/replay.md) of the simulated logs: bags, ground
+// truth, the sensors as simulated and the IMU time offset as if calibrated.
+std::string Manifest(const Scenario& s) {
+  std::ostringstream os;
+  os << std::setprecision(17);
+  os << "# Replay manifest of the simulated run (written by swarmlio_sim).\n";
+  os << "# swarmlio_replay --manifest=<this file> --output_dir=...\n";
+  os << "name: " << s.options.name << "\n";
+  os << "drones:\n";
+  for (const DroneConfig& d : s.drones) {
+    os << "  - name: " << d.name << "\n";
+    os << "    bag: " << d.name << ".bag\n";
+    os << "    ground_truth: " << d.name << "_gt_tum.txt\n";
+    os << Indented(config::DumpOptions(d.lidar.sensor, "lidar"), "    ");
+    os << Indented(config::DumpOptions(d.imu.sensor, "imu"), "    ");
+    os << "    odometry:\n";
+    os << "      # IMU stamps later than the LiDAR's (the simulated offset, as if calibrated)\n";
+    os << "      imu_time_offset_s: " << d.imu.time_offset_s << "\n";
   }
   return os.str();
 }
@@ -104,6 +133,12 @@ int Main() {
     out << Resolved(scenario, sim);
     if (!out) {
       std::fprintf(stderr, "error: cannot write resolved_scenario.yaml\n");
+      return 1;
+    }
+    std::ofstream manifest(dir / "swarm.yaml");
+    manifest << Manifest(scenario);
+    if (!manifest) {
+      std::fprintf(stderr, "error: cannot write swarm.yaml\n");
       return 1;
     }
   }

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "factors/point_to_plane_factor.h"
+#include "swarmlio/config/option_fields.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/state/swarm_state.h"
 
@@ -38,8 +39,19 @@ struct EsikfUpdateOptions {
   /// DENSE_NORMAL_CHOLESKY (default, fastest for ~18-40 columns) or DENSE_QR.
   ceres::LinearSolverType linear_solver = ceres::DENSE_NORMAL_CHOLESKY;
 
-  /// Ok, or InvalidArgument naming the offending field.
-  Status Validate() const;
+  template <class V>
+  void VisitFields(V&& v) {
+    using config::FieldSpec;
+    v("max_iterations", max_iterations,
+      FieldSpec::InRange(1.0, 100.0, "", "outer iterations (re-association + Gauss-Newton step)"));
+    v("convergence_rotation_rad", convergence_rotation_rad,
+      FieldSpec::Positive("rad", "converged when every rotation step is below this"));
+    v("convergence_translation_m", convergence_translation_m,
+      FieldSpec::Positive("m", "converged when every translation step is below this"));
+  }
+
+  /// "" when valid, else "key: reason".
+  std::string Validate() const;
 };
 
 /// Fills `out` (cleared by the caller) with the plane correspondences of the

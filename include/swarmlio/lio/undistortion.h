@@ -21,6 +21,7 @@
 
 #include "swarmlio/common/status.h"
 #include "swarmlio/lio/imu_propagator.h"
+#include "swarmlio/lio/voxel_filter.h"
 #include "swarmlio/sensors/measurements.h"
 
 namespace swarmlio {
@@ -59,5 +60,14 @@ Status UndistortScan(const LidarScan& scan,
                      const Eigen::Vector3d& p_lidar_in_imu_m,
                      std::vector<UndistortedPoint>* points,
                      UndistortionStats* stats = nullptr);
+
+/// The same motion compensation for points already in the body frame (the
+/// output of lio::Preprocess, times relative to `scan_stamp_ns`): writes
+/// p_in_b_end for each point, in input order, into `*points_in_b_end`.
+Status UndistortPoints(const std::vector<lio::PointXYZT>& points_in_b,
+                       int64_t scan_stamp_ns,
+                       const std::vector<ImuPose>& poses,
+                       std::vector<Eigen::Vector3d>* points_in_b_end,
+                       UndistortionStats* stats = nullptr);
 
 }  // namespace swarmlio

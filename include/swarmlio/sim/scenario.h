@@ -63,9 +63,4 @@ Status LoadScenario(const std::string& path, Scenario* scenario);
 /// resolving `scenario.preset_dir` (relative to the folder of `name`).
 Status ParseScenario(const std::string& yaml_text, const std::string& name, Scenario* scenario);
 
-/// Reads the `lidar` and `imu` sections of a sensor preset file
-/// (configs/*.yaml) over `*lidar` and `*imu` (either may be null to skip it).
-/// A file with neither section is an error.
-Status LoadSensorPreset(const std::string& path, LidarOptions* lidar, ImuOptions* imu);
-
 }  // namespace swarmlio::sim

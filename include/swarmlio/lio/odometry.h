@@ -1,0 +1,138 @@
+// lio::Odometry: the single-drone LiDAR-inertial odometry (paper Sec. III-D,
+// ego part; FAST-LIO2's pipeline), a pure core fed with IMU samples and LiDAR
+// scans in stamp order. docs/lio.md describes the pipeline and its figures.
+//
+// Per scan [t_s, t_e] (t_e = stamp + last point time), once IMU data reach t_e:
+//   1. preprocess (filters, stride, range gate, voxel) -> points in b with times;
+//   2. propagate the state over the scan's IMU samples to t_e (eq. (2)-(3));
+//   3. undistort every point to the body frame at t_e;
+//   4. iterated update (EsikfUpdate: prior + point-to-plane on Ceres), the
+//      association re-evaluated at each iteration against the local map;
+//   5. insert the registered points into the local map, move the map box.
+// The first scan after IMU initialization only builds the map.
+//
+// Before the first scan can be used the IMU must initialize from a static
+// window (ImuInitializer); scans before that are dropped and counted.
+// Threading: none inside; one instance per drone, not thread-safe.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/lio/odometry_options.h"
+#include "swarmlio/sensors/lidar_options.h"
+#include "swarmlio/sensors/measurements.h"
+#include "swarmlio/state/swarm_state.h"
+
+namespace swarmlio::lio {
+
+/// Wall time of each stage of one scan [s].
+struct ScanTimings {
+  double preprocess_s = 0.0;   // filters + voxel downsampling
+  double propagate_s = 0.0;    // IMU propagation over the scan
+  double undistort_s = 0.0;    // motion compensation
+  double association_s = 0.0;  // kNN + plane fits, all iterations
+  double solve_s = 0.0;        // ceres::Solve, all iterations
+  double covariance_s = 0.0;   // posterior covariance
+  double map_update_s = 0.0;   // registration into G + map insertion + box move
+  double total_s = 0.0;        // whole scan, including everything above
+};
+
+/// What the odometry reports for one processed scan.
+struct ScanOutput {
+  int64_t scan_stamp_ns = 0;  // the scan's stamp (its first point time)
+  int64_t stamp_ns = 0;       // the state's time: the scan end
+  EgoState state;             // posterior (or prediction when not updated)
+  Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim> covariance;
+  bool updated = false;           // false: map initialisation, too few points, failed update
+  std::string update_error;       // why an attempted update failed ("" otherwise)
+  int num_raw_points = 0;         // points in the message
+  int num_points = 0;             // after preprocessing
+  int num_correspondences = 0;    // at the last iteration
+  int iterations = 0;
+  bool converged = false;
+  size_t map_size = 0;            // map points after the insertion
+  ScanTimings timings;
+  std::vector<Eigen::Vector3d> registered_in_G;  // when output_registered_scan
+};
+
+/// Counters of everything the odometry skipped or dropped.
+struct OdometryCounters {
+  int64_t imu_samples = 0;
+  int64_t imu_rejected = 0;          // non-finite samples (dropped)
+  int64_t imu_out_of_order = 0;      // stamp not after the previous one (dropped)
+  int64_t imu_gaps = 0;              // intervals > propagation.max_gap_s (state held)
+  int64_t scans = 0;
+  int64_t scans_before_init = 0;     // dropped: IMU not initialized yet
+  int64_t scans_out_of_order = 0;    // dropped: started before the previous scan ended
+  int64_t scans_empty = 0;           // dropped: no points
+  int64_t scans_dropped_queue = 0;   // dropped: waited too long for IMU data
+  int64_t scans_processed = 0;
+  int64_t scans_updated = 0;
+  int64_t updates_failed = 0;        // update refused (prediction kept)
+};
+
+class Odometry {
+ public:
+  /// InvalidArgument when the options or the LiDAR extrinsic do not validate.
+  static Status Create(const OdometryOptions& options, const LidarOptions& lidar,
+                       std::unique_ptr<Odometry>* odometry);
+  ~Odometry();
+
+  /// Feeds one IMU sample (raw units; the initializer finds the unit).
+  /// Non-finite or out-of-order samples are dropped and counted: the
+  /// returned Status says so (InvalidArgument), nothing else changes. May
+  /// process queued scans (outputs via PopOutputs()); an error of that
+  /// processing is returned too (the scan is counted and skipped).
+  Status AddImu(const ImuSample& sample);
+
+  /// Queues a scan; it is processed once IMU data cover its end. Returns a
+  /// non-ok Status when the scan is dropped (empty, out of order, queue full).
+  Status AddScan(const LidarScan& scan);
+
+  /// Processes every queued scan with the IMU data at hand (the last input
+  /// held up to the scan end): call at the end of a log.
+  Status Flush();
+
+  /// Moves the outputs of the scans processed so far into `*outputs`
+  /// (appended) and forgets them.
+  void PopOutputs(std::vector<ScanOutput>* outputs);
+
+  bool initialized() const;
+  /// Why the IMU has not initialized yet ("" once it has).
+  const std::string& initialization_error() const { return init_error_; }
+  /// The initialization result (valid once initialized()).
+  const ImuInitialization& initialization() const;
+
+  /// Current full state and covariance (the last update or propagation).
+  const SwarmState& state() const;
+  const Eigen::MatrixXd& covariance() const;
+
+  /// Every map point (G frame), e.g. to save the map at the end.
+  std::vector<Eigen::Vector3d> MapPoints() const;
+  size_t map_size() const;
+  size_t MapMemoryBytes() const;
+
+  const OdometryCounters& counters() const { return counters_; }
+  const OdometryOptions& options() const { return options_; }
+
+ private:
+  struct Impl;
+  Odometry(const OdometryOptions& options, const LidarOptions& lidar);
+
+  Status ProcessReadyScans(bool flush);
+  Status ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush);
+
+  OdometryOptions options_;
+  LidarOptions lidar_;
+  std::unique_ptr<Impl> impl_;
+  OdometryCounters counters_;
+  std::string init_error_ = "no IMU data yet";
+};
+
+}  // namespace swarmlio::lio

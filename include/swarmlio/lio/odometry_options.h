@@ -1,0 +1,66 @@
+// OdometryOptions: every setting of the single-drone LiDAR-inertial odometry
+// (lio::Odometry), one YAML section `odometry:` (docs/lio.md lists the keys).
+// Sensor-dependent defaults come from OdometryOptionsFor(LidarOptions).
+#pragma once
+
+#include <string>
+
+#include "swarmlio/config/option_fields.h"
+#include "swarmlio/lio/esikf_update.h"
+#include "swarmlio/lio/imu_initializer.h"
+#include "swarmlio/lio/imu_propagator.h"
+#include "swarmlio/lio/local_map.h"
+#include "swarmlio/lio/preprocess.h"
+#include "swarmlio/lio/scan_association.h"
+#include "swarmlio/sensors/lidar_options.h"
+
+namespace swarmlio::lio {
+
+struct OdometryOptions {
+  ImuInitializerOptions imu_init;
+  ImuPropagatorOptions propagation;
+  PreprocessOptions preprocess;
+  LocalMapOptions map;
+  AssociationOptions association;
+  EsikfUpdateOptions update;
+  /// IMU stamps are this much later than the LiDAR's clock; subtracted from
+  /// every IMU stamp (FAST-LIO time_offset_lidar_to_imu) [s].
+  double imu_time_offset_s = 0.0;
+  /// A scan with fewer preprocessed points is not used for an update (the
+  /// state is only propagated) [points].
+  int min_scan_points = 20;
+  /// Scans waiting for IMU data beyond this many: the oldest is dropped
+  /// (the IMU stream stopped) [scans].
+  int max_queued_scans = 20;
+  /// Keep the registered (posterior, G frame) downsampled scan in each output.
+  bool output_registered_scan = false;
+
+  template <class V>
+  void VisitFields(V&& v) {
+    using config::FieldSpec;
+    v("imu_init", imu_init);
+    v("propagation", propagation);
+    v("preprocess", preprocess);
+    v("map", map);
+    v("association", association);
+    v("update", update);
+    v("imu_time_offset_s", imu_time_offset_s,
+      FieldSpec::InRange(-1.0, 1.0, "s", "subtracted from IMU stamps (IMU clock minus LiDAR clock)"));
+    v("min_scan_points", min_scan_points,
+      FieldSpec::InRange(1.0, 1e6, "", "fewer preprocessed points: propagate only, no update"));
+    v("max_queued_scans", max_queued_scans,
+      FieldSpec::InRange(1.0, 1000.0, "", "scans waiting for IMU data before the oldest is dropped"));
+    v("output_registered_scan", output_registered_scan,
+      FieldSpec::Doc("keep the registered scan (G frame) in each per-scan output"));
+  }
+
+  /// "" when valid, else "key: reason".
+  std::string Validate() const { return config::ValidateFields(*this); }
+};
+
+/// Defaults for a sensor: preprocessing from PreprocessOptionsFor(lidar), the
+/// map voxel from Swarm-LIO2's configs (filter_size_map 0.3 m Mid-360, 0.25 m
+/// Avia, 0.5 m otherwise) and the map cube from the sensor's max range.
+OdometryOptions OdometryOptionsFor(const LidarOptions& lidar);
+
+}  // namespace swarmlio::lio

@@ -1,0 +1,96 @@
+// ScanAssociator: the plane correspondences of one undistorted scan against
+// the local map at a state estimate (paper eq. (4); the association callback
+// of EsikfUpdate).
+//
+// For each scan point p (body frame at the scan end) at the estimate
+// (R_G_b, p_b_in_G): q = R_G_b p + p_b_in_G; its k nearest map points give a
+// plane (FitPlane, PCA with the planarity test); the correspondence is kept
+// when the point is close to the plane relative to its range, FAST-LIO's
+// gate  |n^T q + d| < residual_gate_factor * sqrt(|p|)  (FAST-LIO:
+// 1 - 0.9 |z| / sqrt(|p|) > 0.9, i.e. factor 1/9). Weight 1 / sigma^2 with
+// sigma = point_stddev_m.
+//
+// Re-association at every outer iteration: the gate and the residual are
+// re-evaluated at each estimate; the nearest-neighbour search (the expensive
+// part) is repeated for a point only when its position in G moved more than
+// research_distance_m since its last search (FAST-LIO searches at the first
+// iteration and after convergence only). With research_distance_m = 0 every
+// iteration searches every point.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "factors/point_to_plane_factor.h"
+#include "swarmlio/common/status.h"
+#include "swarmlio/config/option_fields.h"
+#include "swarmlio/lio/local_map.h"
+#include "swarmlio/lio/plane_fit.h"
+#include "swarmlio/state/swarm_state.h"
+
+namespace swarmlio::lio {
+
+struct AssociationOptions {
+  int num_neighbors = 5;                 // k of the plane fit (NUM_MATCH_POINTS)
+  double point_stddev_m = 0.0316;        // sigma of z: FAST-LIO LASER_POINT_COV 0.001 m^2 [m]
+  double residual_gate_factor = 1.0 / 9.0;  // keep |z| < factor * sqrt(|p_b|) [sqrt(m)]
+  double research_distance_m = 0.05;     // re-search neighbours after moving this far [m]
+  PlaneFitOptions plane;
+
+  template <class V>
+  void VisitFields(V&& v) {
+    using config::FieldSpec;
+    v("num_neighbors", num_neighbors,
+      FieldSpec::InRange(3.0, 50.0, "", "map neighbours per plane (NUM_MATCH_POINTS)"));
+    v("point_stddev_m", point_stddev_m,
+      FieldSpec::Positive("m", "point-to-plane measurement standard deviation"));
+    v("residual_gate_factor", residual_gate_factor,
+      FieldSpec::Positive("m^0.5", "keep |z| < factor * sqrt(range); FAST-LIO 1/9"));
+    v("research_distance_m", research_distance_m,
+      FieldSpec::AtLeast(0.0, "m",
+                         "repeat a point's neighbour search when it moved this far; 0 = always"));
+    v("plane", plane);
+  }
+  std::string Validate() const { return config::ValidateFields(*this); }
+};
+
+struct AssociationStats {
+  int num_points = 0;
+  int num_searched = 0;       // neighbour searches run in the last call
+  int num_no_plane = 0;       // too few / too far neighbours, not planar
+  int num_gated = 0;          // plane found, residual too large
+  int num_correspondences = 0;
+};
+
+class ScanAssociator {
+ public:
+  /// `map` must outlive the associator and not change while it is in use.
+  ScanAssociator(const LocalMap* map, const AssociationOptions& options);
+
+  /// Starts a new scan: `points_in_b` (body frame at the scan end) must
+  /// outlive the calls to Associate(). Forgets cached neighbours.
+  void Reset(const std::vector<Eigen::Vector3d>* points_in_b);
+
+  /// Fills `*out` (cleared) with the correspondences at the estimate `x`.
+  Status Associate(const SwarmState& x, std::vector<PlaneCorrespondence>* out);
+
+  /// Statistics of the last Associate() call.
+  const AssociationStats& stats() const { return stats_; }
+
+ private:
+  struct CachedPlane {
+    Eigen::Vector3d searched_at_in_G = Eigen::Vector3d::Constant(1e300);
+    bool has_plane = false;
+    Plane plane;
+  };
+
+  const LocalMap* map_;
+  AssociationOptions options_;
+  const std::vector<Eigen::Vector3d>* points_in_b_ = nullptr;
+  std::vector<CachedPlane> cache_;
+  std::vector<Neighbor> neighbors_;  // scratch
+  AssociationStats stats_;
+};
+
+}  // namespace swarmlio::lio

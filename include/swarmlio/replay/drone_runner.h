@@ -1,0 +1,82 @@
+// DroneRunner: one drone of an offline replay. It owns the drone's bag
+// reader and estimator; the replay loop asks for the stamp of its next record
+// and lets it consume that record (so N drones interleave in stamp order).
+// It keeps per-scan results (bounded: a few hundred bytes a scan) and the
+// ground truth found in the bag.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/io/bag_reader.h"
+#include "swarmlio/lio/odometry.h"
+#include "swarmlio/replay/manifest.h"
+#include "swarmlio/sensors/measurements.h"
+
+namespace swarmlio::replay {
+
+/// The per-scan record kept for evaluation and reports.
+struct ScanRecord {
+  int64_t stamp_ns = 0;  // state time (scan end)
+  EgoState state;
+  /// Covariance of [dtheta, dp] (rotation, position), ErrorStateLayout order.
+  Eigen::Matrix<double, 6, 6> pose_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool updated = false;
+  int num_raw_points = 0;
+  int num_points = 0;
+  int num_correspondences = 0;
+  int iterations = 0;
+  size_t map_size = 0;
+  lio::ScanTimings timings;
+};
+
+struct DroneWarnings {
+  int64_t count = 0;
+  std::string first;  // the first warning's message
+};
+
+class DroneRunner {
+ public:
+  /// Opens the bag and creates the estimator. Errors name the drone.
+  static Status Create(const DroneInput& input, std::unique_ptr<DroneRunner>* runner);
+
+  /// True while the bag has records left (after Prime()).
+  bool has_next() const { return has_next_; }
+  /// Stamp of the next record (valid when has_next()).
+  int64_t next_stamp_ns() const;
+  /// Feeds the next record to the estimator and reads the one after it.
+  /// Data problems the estimator skips (NaN sample, out-of-order scan) are
+  /// counted as warnings, not errors; a bag read error is returned.
+  Status Step();
+  /// End of the log: processes the scans still waiting for IMU data.
+  Status Finish();
+
+  const DroneInput& input() const { return input_; }
+  const std::vector<ScanRecord>& scans() const { return scans_; }
+  const std::vector<PoseStamped>& bag_ground_truth() const { return ground_truth_; }
+  const lio::Odometry& odometry() const { return *odometry_; }
+  const io::BagReader& reader() const { return *reader_; }
+  const DroneWarnings& warnings() const { return warnings_; }
+
+ private:
+  DroneRunner() = default;
+  Status ReadNext();
+  void Collect();
+  void Warn(const Status& status);
+
+  DroneInput input_;
+  std::unique_ptr<io::BagReader> reader_;
+  std::unique_ptr<lio::Odometry> odometry_;
+  io::BagRecord next_;
+  bool has_next_ = false;
+  std::vector<ScanRecord> scans_;
+  std::vector<lio::ScanOutput> outputs_;  // scratch
+  std::vector<PoseStamped> ground_truth_;
+  DroneWarnings warnings_;
+};
+
+}  // namespace swarmlio::replay

@@ -1,0 +1,59 @@
+// SwarmManifest: which logs make up one swarm run, one entry per drone
+// (docs/replay.md). The simulator writes one (swarm.yaml) next to its bags;
+// for recorded flights the user writes it by hand:
+//
+//   name: lab_flight_3
+//   drones:
+//     - name: uav1
+//       bag: uav1.bag                   # relative to this file's folder
+//       ground_truth: uav1_gt_tum.txt   # optional TUM file (else the bag's topic, if any)
+//       sensor_preset: ../configs/livox_mid360.yaml   # lidar: + imu: sections
+//       lidar: {p_lidar_in_imu_m: [0, 0, 0.08]}        # optional overrides
+//       bag_topics: {imu_topic: /mavros/imu/data}
+//       odometry: {imu_time_offset_s: 0.002}
+//
+// Odometry defaults follow the drone's LiDAR (lio::OdometryOptionsFor), then
+// the `odometry:` keys apply over them; the IMU initializer takes the
+// acceleration unit of the `imu:` section.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/io/bag_options.h"
+#include "swarmlio/lio/odometry_options.h"
+#include "swarmlio/sensors/imu_options.h"
+#include "swarmlio/sensors/lidar_options.h"
+
+namespace swarmlio::replay {
+
+struct DroneInput {
+  std::string name;
+  std::string bag_path;           // resolved (relative to the manifest folder)
+  std::string ground_truth_path;  // resolved TUM file, "" = none
+  LidarOptions lidar;
+  ImuOptions imu;
+  io::BagReaderOptions bag;
+  lio::OdometryOptions odometry;
+};
+
+struct SwarmManifest {
+  std::string name;
+  std::vector<DroneInput> drones;
+};
+
+/// Loads and validates a manifest. Errors name file:line: key. Drone names
+/// must be unique and non-empty; bags must be given (existence is checked
+/// when they are opened).
+Status LoadManifest(const std::string& path, SwarmManifest* manifest);
+/// Same from YAML text; `name` stands for the file (messages, relative paths).
+Status ParseManifest(const std::string& yaml_text, const std::string& name,
+                     SwarmManifest* manifest);
+
+/// A manifest for bags given on the command line: every drone uses the same
+/// sensor preset (may be ""), names uav1, uav2, ... unless `names` is given.
+Status ManifestFromBags(const std::vector<std::string>& bags, const std::string& sensor_preset,
+                        const std::vector<std::string>& names, SwarmManifest* manifest);
+
+}  // namespace swarmlio::replay

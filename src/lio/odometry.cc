@@ -1,0 +1,299 @@
+#include "swarmlio/lio/odometry.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "swarmlio/lio/esikf_update.h"
+#include "swarmlio/lio/imu_initializer.h"
+#include "swarmlio/lio/imu_propagator.h"
+#include "swarmlio/lio/local_map.h"
+#include "swarmlio/lio/preprocess.h"
+#include "swarmlio/lio/scan_association.h"
+#include "swarmlio/lio/undistortion.h"
+
+namespace swarmlio::lio {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+int64_t ScanEndNs(const LidarScan& scan) {
+  double last_s = 0.0;
+  for (const LidarPoint& p : scan.points) {
+    if (std::isfinite(p.offset_time_s)) last_s = std::max(last_s, p.offset_time_s);
+  }
+  return scan.stamp_ns + static_cast<int64_t>(std::llround(last_s * 1e9));
+}
+
+bool IsFinite(const SwarmState& x, const Eigen::MatrixXd& P) {
+  return x.ego.q_G_b.coeffs().allFinite() && x.ego.p_b_in_G.allFinite() &&
+         x.ego.v_b_in_G.allFinite() && x.ego.gyro_bias.allFinite() &&
+         x.ego.accel_bias.allFinite() && x.ego.g_in_G.allFinite() && P.allFinite();
+}
+
+struct PendingScan {
+  LidarScan scan;
+  int64_t end_ns = 0;
+};
+
+}  // namespace
+
+struct Odometry::Impl {
+  std::unique_ptr<ImuInitializer> initializer;
+  ImuInitialization initialization;
+  bool initialized = false;
+  std::unique_ptr<ImuPropagator> propagator;
+  std::unique_ptr<Preprocess> preprocess;
+  LocalMap map;
+  ScanAssociator associator;
+  EsikfUpdate update;
+  std::deque<ImuSample> imu_queue;  // after initialization, not yet propagated
+  std::deque<PendingScan> scan_queue;
+  std::vector<ScanOutput> outputs;
+  int64_t last_imu_stamp_ns = 0;
+  bool have_imu = false;
+  int64_t last_scan_end_ns = 0;
+  bool have_scan = false;
+  // Scratch reused between scans.
+  std::vector<PointXYZT> points_in_b;
+  std::vector<Eigen::Vector3d> undistorted;
+
+  Impl(const OdometryOptions& options)
+      : map(options.map), associator(&map, options.association), update(options.update) {}
+};
+
+Status Odometry::Create(const OdometryOptions& options, const LidarOptions& lidar,
+                        std::unique_ptr<Odometry>* odometry) {
+  if (const std::string invalid = options.Validate(); !invalid.empty()) {
+    return Status::InvalidArgument("odometry options: " + invalid);
+  }
+  if (const std::string invalid = lidar.Validate(); !invalid.empty()) {
+    return Status::InvalidArgument("lidar options: " + invalid);
+  }
+  std::unique_ptr<Odometry> out(new Odometry(options, lidar));
+  SWARMLIO_RETURN_IF_ERROR(ImuInitializer::Create(options.imu_init, &out->impl_->initializer));
+  SWARMLIO_RETURN_IF_ERROR(ImuPropagator::Create(options.propagation, &out->impl_->propagator));
+  out->impl_->preprocess = std::make_unique<Preprocess>(
+      options.preprocess, lidar.QuaternionImuLidar().toRotationMatrix(), lidar.p_lidar_in_imu_m);
+  *odometry = std::move(out);
+  return Status::Ok();
+}
+
+Odometry::Odometry(const OdometryOptions& options, const LidarOptions& lidar)
+    : options_(options), lidar_(lidar), impl_(std::make_unique<Impl>(options)) {}
+
+Odometry::~Odometry() = default;
+
+bool Odometry::initialized() const { return impl_->initialized; }
+const ImuInitialization& Odometry::initialization() const { return impl_->initialization; }
+const SwarmState& Odometry::state() const { return impl_->propagator->state(); }
+const Eigen::MatrixXd& Odometry::covariance() const { return impl_->propagator->covariance(); }
+std::vector<Eigen::Vector3d> Odometry::MapPoints() const { return impl_->map.Points(); }
+size_t Odometry::map_size() const { return impl_->map.size(); }
+size_t Odometry::MapMemoryBytes() const { return impl_->map.MemoryBytes(); }
+
+void Odometry::PopOutputs(std::vector<ScanOutput>* outputs) {
+  for (ScanOutput& o : impl_->outputs) outputs->push_back(std::move(o));
+  impl_->outputs.clear();
+}
+
+Status Odometry::AddImu(const ImuSample& raw) {
+  ++counters_.imu_samples;
+  ImuSample sample = raw;
+  sample.stamp_ns -= static_cast<int64_t>(std::llround(options_.imu_time_offset_s * 1e9));
+  if (!sample.angular_velocity_rad_s.allFinite() || !sample.linear_acceleration.allFinite()) {
+    ++counters_.imu_rejected;
+    return Status::InvalidArgument("IMU sample at " + std::to_string(raw.stamp_ns) +
+                                   " ns has non-finite values; dropped");
+  }
+  if (impl_->have_imu && sample.stamp_ns <= impl_->last_imu_stamp_ns) {
+    ++counters_.imu_out_of_order;
+    return Status::InvalidArgument("IMU sample at " + std::to_string(raw.stamp_ns) +
+                                   " ns is not after the previous one; dropped");
+  }
+  impl_->have_imu = true;
+  impl_->last_imu_stamp_ns = sample.stamp_ns;
+  if (!impl_->initialized) {
+    SWARMLIO_RETURN_IF_ERROR(impl_->initializer->AddSample(sample));
+    if (!impl_->initializer->WindowFull()) {
+      init_error_ = "IMU window not full yet (" +
+                    std::to_string(impl_->initializer->num_samples_in_window()) + " samples)";
+      return Status::Ok();
+    }
+    ImuInitialization init;
+    const Status status = impl_->initializer->Initialize(&init);
+    if (!status.ok()) {
+      init_error_ = status.message();
+      return Status::Ok();  // keep sliding the window
+    }
+    SWARMLIO_RETURN_IF_ERROR(impl_->propagator->Reset(init));
+    impl_->initialization = init;
+    impl_->initialized = true;
+    init_error_.clear();
+    return Status::Ok();
+  }
+  impl_->imu_queue.push_back(sample);
+  return ProcessReadyScans(/*flush=*/false);
+}
+
+Status Odometry::AddScan(const LidarScan& scan) {
+  ++counters_.scans;
+  if (scan.points.empty()) {
+    ++counters_.scans_empty;
+    return Status::InvalidArgument("scan at " + std::to_string(scan.stamp_ns) +
+                                   " ns has no points; dropped");
+  }
+  if (!impl_->initialized || scan.stamp_ns < impl_->initialization.stamp_ns) {
+    ++counters_.scans_before_init;
+    return Status::Ok();  // expected during the static start: not an error
+  }
+  const int64_t end_ns = ScanEndNs(scan);
+  const int64_t previous_end_ns = impl_->scan_queue.empty() ? impl_->last_scan_end_ns
+                                                            : impl_->scan_queue.back().end_ns;
+  if ((impl_->have_scan || !impl_->scan_queue.empty()) && end_ns <= previous_end_ns) {
+    ++counters_.scans_out_of_order;
+    return Status::InvalidArgument("scan at " + std::to_string(scan.stamp_ns) +
+                                   " ns does not end after the previous scan; dropped");
+  }
+  impl_->scan_queue.push_back({scan, end_ns});
+  Status status;
+  if (static_cast<int>(impl_->scan_queue.size()) > options_.max_queued_scans) {
+    ++counters_.scans_dropped_queue;
+    status = Status::OutOfRange("no IMU data for " + std::to_string(options_.max_queued_scans) +
+                                " scans: dropped the scan at " +
+                                std::to_string(impl_->scan_queue.front().scan.stamp_ns) + " ns");
+    impl_->scan_queue.pop_front();
+  }
+  const Status processed = ProcessReadyScans(/*flush=*/false);
+  return status.ok() ? processed : status;
+}
+
+Status Odometry::Flush() { return ProcessReadyScans(/*flush=*/true); }
+
+Status Odometry::ProcessReadyScans(bool flush) {
+  Status first_error;
+  while (!impl_->scan_queue.empty()) {
+    const PendingScan& next = impl_->scan_queue.front();
+    const bool imu_covers = impl_->have_imu && impl_->last_imu_stamp_ns >= next.end_ns;
+    if (!imu_covers && !flush) break;
+    PendingScan pending = std::move(impl_->scan_queue.front());
+    impl_->scan_queue.pop_front();
+    const Status status = ProcessScan(pending.scan, pending.end_ns, flush);
+    if (!status.ok() && first_error.ok()) first_error = status;
+  }
+  return first_error;
+}
+
+Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) {
+  Impl& im = *impl_;
+  const Clock::time_point t_start = Clock::now();
+  ScanOutput out;
+  out.scan_stamp_ns = scan.stamp_ns;
+  out.num_raw_points = static_cast<int>(scan.points.size());
+
+  // 1. Preprocess.
+  Clock::time_point t = Clock::now();
+  im.preprocess->Run(scan, &im.points_in_b);
+  out.num_points = static_cast<int>(im.points_in_b.size());
+  out.timings.preprocess_s = SecondsSince(t);
+
+  // 2. Propagate over the scan's IMU samples to its end.
+  t = Clock::now();
+  ImuPropagator& prop = *im.propagator;
+  if (end_ns < prop.stamp_ns()) {
+    ++counters_.scans_out_of_order;
+    return Status::InvalidArgument("scan ending at " + std::to_string(end_ns) +
+                                   " ns ends before the current state time; dropped");
+  }
+  prop.StartScan();
+  Status first_error;
+  while (!im.imu_queue.empty() && im.imu_queue.front().stamp_ns <= end_ns) {
+    const ImuSample sample = im.imu_queue.front();
+    im.imu_queue.pop_front();
+    Status status = prop.AddImu(sample);
+    if (status.code() == Status::Code::kOutOfRange) {
+      // A gap in the IMU stream: hold the state and restart from this sample.
+      ++counters_.imu_gaps;
+      const SwarmState x = prop.state();
+      const Eigen::MatrixXd P = prop.covariance();
+      SWARMLIO_RETURN_IF_ERROR(prop.Reset(x, P, sample, im.initialization.acceleration_to_m_s2));
+      if (first_error.ok()) first_error = status;
+    } else if (!status.ok() && first_error.ok()) {
+      first_error = status;
+    }
+  }
+  const ImuSample* next = im.imu_queue.empty() ? nullptr : &im.imu_queue.front();
+  if (Status status = prop.PropagateTo(end_ns, next); !status.ok()) {
+    if (!flush || status.code() != Status::Code::kOutOfRange) return status;
+    // Flushing past the end of the IMU data: hold the state at its last time.
+  }
+  out.timings.propagate_s = SecondsSince(t);
+
+  // 3. Motion compensation to the scan end.
+  t = Clock::now();
+  SWARMLIO_RETURN_IF_ERROR(UndistortPoints(im.points_in_b, scan.stamp_ns, prop.scan_poses(),
+                                           &im.undistorted));
+  out.timings.undistort_s = SecondsSince(t);
+
+  // 4. Update.
+  SwarmState x = prop.state();
+  Eigen::MatrixXd P = prop.covariance();
+  const bool map_ready = !im.map.empty();
+  const bool enough_points = static_cast<int>(im.undistorted.size()) >= options_.min_scan_points;
+  if (map_ready && enough_points) {
+    im.associator.Reset(&im.undistorted);
+    const EsikfUpdateResult result = im.update.Run(
+        x, P, [&](const SwarmState& at, std::vector<PlaneCorrespondence>* correspondences) {
+          return im.associator.Associate(at, correspondences);
+        });
+    out.timings.association_s = result.association_time_s;
+    out.timings.solve_s = result.solve_time_s;
+    out.timings.covariance_s = result.covariance_time_s;
+    out.iterations = result.iterations;
+    out.converged = result.converged;
+    out.num_correspondences = result.num_correspondences;
+    if (result.status.ok() && IsFinite(result.state, result.covariance)) {
+      x = result.state;
+      P = result.covariance;
+      out.updated = true;
+      ++counters_.scans_updated;
+      prop.SetState(x, P);
+    } else {
+      ++counters_.updates_failed;
+      out.update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
+    }
+  }
+
+  // 5. Map: register with the (posterior) state and insert. Only updated
+  // scans and the very first one grow the map, so a failed update cannot
+  // write a misregistered scan into it.
+  t = Clock::now();
+  if (out.updated || !map_ready) {
+    const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
+    std::vector<Eigen::Vector3d> registered;
+    registered.reserve(im.undistorted.size());
+    for (const Eigen::Vector3d& p : im.undistorted) registered.push_back(R_G_b * p + x.ego.p_b_in_G);
+    im.map.UpdateCenter(x.ego.p_b_in_G);
+    im.map.Insert(registered);
+    if (options_.output_registered_scan) out.registered_in_G = std::move(registered);
+  }
+  out.map_size = im.map.size();
+  out.timings.map_update_s = SecondsSince(t);
+
+  out.stamp_ns = prop.stamp_ns();
+  out.state = x.ego;
+  out.covariance = P.topLeftCorner<ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>();
+  out.timings.total_s = SecondsSince(t_start);
+  im.last_scan_end_ns = end_ns;
+  im.have_scan = true;
+  ++counters_.scans_processed;
+  im.outputs.push_back(std::move(out));
+  return first_error;
+}
+
+}  // namespace swarmlio::lio

@@ -1,0 +1,57 @@
+#include "swarmlio/lio/scan_association.h"
+
+#include <cmath>
+
+namespace swarmlio::lio {
+
+ScanAssociator::ScanAssociator(const LocalMap* map, const AssociationOptions& options)
+    : map_(map), options_(options) {}
+
+void ScanAssociator::Reset(const std::vector<Eigen::Vector3d>* points_in_b) {
+  points_in_b_ = points_in_b;
+  cache_.assign(points_in_b == nullptr ? 0 : points_in_b->size(), CachedPlane());
+}
+
+Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespondence>* out) {
+  out->clear();
+  stats_ = AssociationStats();
+  if (points_in_b_ == nullptr) {
+    return Status::FailedPrecondition("ScanAssociator: Reset() with the scan points first");
+  }
+  const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
+  const Eigen::Vector3d& p_b_in_G = x.ego.p_b_in_G;
+  const double research_sq = options_.research_distance_m * options_.research_distance_m;
+  const double weight = 1.0 / (options_.point_stddev_m * options_.point_stddev_m);
+  const std::vector<Eigen::Vector3d>& points = *points_in_b_;
+  stats_.num_points = static_cast<int>(points.size());
+  out->reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d q_in_G = R_G_b * points[i] + p_b_in_G;
+    CachedPlane& cached = cache_[i];
+    if (research_sq == 0.0 || (q_in_G - cached.searched_at_in_G).squaredNorm() > research_sq) {
+      cached.searched_at_in_G = q_in_G;
+      map_->KNearest(q_in_G, options_.num_neighbors, &neighbors_);
+      cached.has_plane = FitPlane(neighbors_, options_.plane, &cached.plane) == PlaneFitStatus::kOk;
+      ++stats_.num_searched;
+    }
+    if (!cached.has_plane) {
+      ++stats_.num_no_plane;
+      continue;
+    }
+    const double z = cached.plane.SignedDistance(q_in_G);
+    if (!(std::abs(z) < options_.residual_gate_factor * std::sqrt(points[i].norm()))) {
+      ++stats_.num_gated;
+      continue;
+    }
+    PlaneCorrespondence c;
+    c.p_in_b = points[i];
+    c.normal_in_G = cached.plane.normal_in_G;
+    c.offset_m = cached.plane.offset_m;
+    c.weight = weight;
+    out->push_back(c);
+  }
+  stats_.num_correspondences = static_cast<int>(out->size());
+  return Status::Ok();
+}
+
+}  // namespace swarmlio::lio

@@ -1,0 +1,160 @@
+#include "swarmlio/replay/manifest.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <set>
+
+#include "swarmlio/config/config_file.h"
+#include "swarmlio/config/sensor_preset.h"
+
+namespace swarmlio::replay {
+namespace {
+
+using config::FieldSpec;
+
+struct DroneEntry {
+  std::string name;
+  std::string bag;
+  std::string ground_truth;
+  std::string sensor_preset;
+  LidarOptions lidar;
+  ImuOptions imu;
+  io::BagReaderOptions bag_topics;
+  lio::OdometryOptions odometry;
+
+  template <class V>
+  void VisitFields(V&& v) {
+    v("name", name, FieldSpec::Doc("drone name (unique; used for output files)"));
+    v("bag", bag, FieldSpec::Doc("ROS1 bag, relative to the manifest's folder"));
+    v("ground_truth", ground_truth,
+      FieldSpec::Doc("TUM ground-truth file, relative to the manifest's folder (optional)"));
+    v("sensor_preset", sensor_preset,
+      FieldSpec::Doc("sensor preset (lidar: and imu: sections), relative to the manifest"));
+    v("lidar", lidar);
+    v("imu", imu);
+    v("bag_topics", bag_topics);
+    v("odometry", odometry);
+  }
+  std::string Validate() const {
+    // Sensors and odometry are validated once merged over the preset.
+    DroneEntry rest = *this;
+    rest.lidar = LidarOptions();
+    rest.imu = ImuOptions();
+    rest.odometry = lio::OdometryOptions();
+    const std::string invalid = config::ValidateFields(rest);
+    if (!invalid.empty()) return invalid;
+    if (name.empty()) return "name: must not be empty";
+    if (bag.empty()) return "bag: must be given";
+    return "";
+  }
+};
+
+struct ManifestFile {
+  std::string name;
+  std::vector<DroneEntry> drones;
+  template <class V>
+  void VisitFields(V&& v) {
+    v("name", name, FieldSpec::Doc("name of the run"));
+    v("drones", drones, FieldSpec::Doc("one entry per drone"));
+  }
+  std::string Validate() const {
+    if (drones.empty()) return "drones: at least one drone is needed";
+    return config::ValidateFields(*this);
+  }
+};
+
+std::string Resolve(const std::filesystem::path& folder, const std::string& path) {
+  if (path.empty()) return "";
+  const std::filesystem::path p(path);
+  return p.is_absolute() ? p.string() : (folder / p).lexically_normal().string();
+}
+
+lio::OdometryOptions DefaultOdometry(const LidarOptions& lidar, const ImuOptions& imu) {
+  lio::OdometryOptions odometry = lio::OdometryOptionsFor(lidar);
+  odometry.imu_init.acceleration_unit = imu.acceleration_unit == AccelerationUnit::kStandardGravity
+                                            ? AccelerationUnitSetting::kStandardGravity
+                                            : AccelerationUnitSetting::kMetersPerSecondSquared;
+  odometry.imu_init.nominal_gravity_m_s2 = imu.gravity_m_s2;
+  return odometry;
+}
+
+}  // namespace
+
+Status ParseManifest(const std::string& yaml_text, const std::string& name,
+                     SwarmManifest* manifest) {
+  config::ConfigFile file;
+  SWARMLIO_RETURN_IF_ERROR(config::ConfigFile::Parse(yaml_text, name, &file));
+  ManifestFile spec;
+  SWARMLIO_RETURN_IF_ERROR(file.Read("", &spec));
+  const std::filesystem::path folder = std::filesystem::path(name).parent_path();
+  SwarmManifest out;
+  out.name = spec.name;
+  std::set<std::string> names;
+  for (size_t i = 0; i < spec.drones.size(); ++i) {
+    const DroneEntry& e = spec.drones[i];
+    const std::string key = config::IndexKey("drones", i);
+    if (!names.insert(e.name).second) {
+      return file.KeyError(key + ".name", "duplicate drone name '" + e.name + "'");
+    }
+    DroneInput d;
+    d.name = e.name;
+    d.bag_path = Resolve(folder, e.bag);
+    d.ground_truth_path = Resolve(folder, e.ground_truth);
+    d.bag = e.bag_topics;
+    if (!e.sensor_preset.empty()) {
+      const Status status =
+          config::LoadSensorPreset(Resolve(folder, e.sensor_preset), &d.lidar, &d.imu);
+      if (!status.ok()) return file.KeyError(key + ".sensor_preset", status.message());
+    }
+    SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".lidar", &d.lidar));
+    SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".imu", &d.imu));
+    d.odometry = DefaultOdometry(d.lidar, d.imu);
+    SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".odometry", &d.odometry));
+    d.bag.point_time_unit = file.HasKey(key + ".bag_topics.point_time_unit")
+                                ? d.bag.point_time_unit
+                                : d.lidar.timestamp_unit;
+    out.drones.push_back(std::move(d));
+  }
+  *manifest = std::move(out);
+  return Status::Ok();
+}
+
+Status LoadManifest(const std::string& path, SwarmManifest* manifest) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound(path + ": cannot open the manifest");
+  std::ostringstream text;
+  text << in.rdbuf();
+  // Relative paths in the manifest resolve against its folder.
+  return ParseManifest(text.str(), path, manifest);
+}
+
+Status ManifestFromBags(const std::vector<std::string>& bags, const std::string& sensor_preset,
+                        const std::vector<std::string>& names, SwarmManifest* manifest) {
+  if (bags.empty()) return Status::InvalidArgument("no bags given");
+  if (!names.empty() && names.size() != bags.size()) {
+    return Status::InvalidArgument(std::to_string(bags.size()) + " bags but " +
+                                   std::to_string(names.size()) + " names");
+  }
+  SwarmManifest out;
+  out.name = "replay";
+  std::set<std::string> seen;
+  for (size_t i = 0; i < bags.size(); ++i) {
+    DroneInput d;
+    d.name = names.empty() ? "uav" + std::to_string(i + 1) : names[i];
+    if (d.name.empty() || !seen.insert(d.name).second) {
+      return Status::InvalidArgument("drone name '" + d.name + "' is empty or repeated");
+    }
+    d.bag_path = bags[i];
+    if (!sensor_preset.empty()) {
+      SWARMLIO_RETURN_IF_ERROR(config::LoadSensorPreset(sensor_preset, &d.lidar, &d.imu));
+    }
+    d.odometry = DefaultOdometry(d.lidar, d.imu);
+    d.bag.point_time_unit = d.lidar.timestamp_unit;
+    out.drones.push_back(std::move(d));
+  }
+  *manifest = std::move(out);
+  return Status::Ok();
+}
+
+}  // namespace swarmlio::replay
