@@ -22,6 +22,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev libyaml-cpp-dev libpcl-dev
   librosbag-storage-dev libsensor-msgs-dev libgeometry-msgs-dev
   libnanoflann-dev robin-map-dev libtbb-dev
+  libcairo2-dev
+  libsodium-dev
 )
 
 log() { printf '\033[1m[swarmlio]\033[0m %s\n' "$*" >&2; }

@@ -257,11 +257,14 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
     out.iterations = result.iterations;
     out.converged = result.converged;
     out.num_correspondences = result.num_correspondences;
+    out.min_normal_information = im.associator.stats().normal_information(0);
+    out.degenerate = out.min_normal_information < options_.association.degeneracy_threshold;
     if (result.status.ok() && IsFinite(result.state, result.covariance)) {
       x = result.state;
       P = result.covariance;
       out.updated = true;
       ++counters_.scans_updated;
+      if (out.degenerate) ++counters_.scans_degenerate;
       prop.SetState(x, P);
     } else {
       ++counters_.updates_failed;

@@ -1,5 +1,6 @@
 #include "swarmlio/lio/scan_association.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 namespace swarmlio::lio {
@@ -51,6 +52,11 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
     out->push_back(c);
   }
   stats_.num_correspondences = static_cast<int>(out->size());
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  for (const PlaneCorrespondence& c : *out) information += c.normal_in_G * c.normal_in_G.transpose();
+  stats_.normal_information = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                                  information, Eigen::EigenvaluesOnly)
+                                  .eigenvalues();
   return Status::Ok();
 }
 

@@ -17,6 +17,23 @@ Status DroneRunner::Create(const DroneInput& input, std::unique_ptr<DroneRunner>
   return Status::Ok();
 }
 
+ScanRecord ToScanRecord(const lio::ScanOutput& o) {
+  ScanRecord r;
+  r.stamp_ns = o.stamp_ns;
+  r.state = o.state;
+  r.pose_covariance = o.covariance.topLeftCorner<6, 6>();
+  r.updated = o.updated;
+  r.num_raw_points = o.num_raw_points;
+  r.num_points = o.num_points;
+  r.num_correspondences = o.num_correspondences;
+  r.iterations = o.iterations;
+  r.min_normal_information = o.min_normal_information;
+  r.degenerate = o.degenerate;
+  r.map_size = o.map_size;
+  r.timings = o.timings;
+  return r;
+}
+
 int64_t DroneRunner::next_stamp_ns() const { return next_.stamp_ns(); }
 
 Status DroneRunner::ReadNext() {
@@ -53,18 +70,7 @@ void DroneRunner::Collect() {
   outputs_.clear();
   odometry_->PopOutputs(&outputs_);
   for (const lio::ScanOutput& o : outputs_) {
-    ScanRecord r;
-    r.stamp_ns = o.stamp_ns;
-    r.state = o.state;
-    r.pose_covariance = o.covariance.topLeftCorner<6, 6>();
-    r.updated = o.updated;
-    r.num_raw_points = o.num_raw_points;
-    r.num_points = o.num_points;
-    r.num_correspondences = o.num_correspondences;
-    r.iterations = o.iterations;
-    r.map_size = o.map_size;
-    r.timings = o.timings;
-    scans_.push_back(r);
+    scans_.push_back(ToScanRecord(o));
     if (!o.update_error.empty()) Warn(Status::Internal("update failed: " + o.update_error));
   }
 }

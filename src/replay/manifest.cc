@@ -70,7 +70,9 @@ std::string Resolve(const std::filesystem::path& folder, const std::string& path
   return p.is_absolute() ? p.string() : (folder / p).lexically_normal().string();
 }
 
-lio::OdometryOptions DefaultOdometry(const LidarOptions& lidar, const ImuOptions& imu) {
+}  // namespace
+
+lio::OdometryOptions DefaultOdometryOptions(const LidarOptions& lidar, const ImuOptions& imu) {
   lio::OdometryOptions odometry = lio::OdometryOptionsFor(lidar);
   odometry.imu_init.acceleration_unit = imu.acceleration_unit == AccelerationUnit::kStandardGravity
                                             ? AccelerationUnitSetting::kStandardGravity
@@ -78,8 +80,6 @@ lio::OdometryOptions DefaultOdometry(const LidarOptions& lidar, const ImuOptions
   odometry.imu_init.nominal_gravity_m_s2 = imu.gravity_m_s2;
   return odometry;
 }
-
-}  // namespace
 
 Status ParseManifest(const std::string& yaml_text, const std::string& name,
                      SwarmManifest* manifest) {
@@ -109,7 +109,7 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     }
     SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".lidar", &d.lidar));
     SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".imu", &d.imu));
-    d.odometry = DefaultOdometry(d.lidar, d.imu);
+    d.odometry = DefaultOdometryOptions(d.lidar, d.imu);
     SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".odometry", &d.odometry));
     d.bag.point_time_unit = file.HasKey(key + ".bag_topics.point_time_unit")
                                 ? d.bag.point_time_unit
@@ -149,7 +149,7 @@ Status ManifestFromBags(const std::vector<std::string>& bags, const std::string&
     if (!sensor_preset.empty()) {
       SWARMLIO_RETURN_IF_ERROR(config::LoadSensorPreset(sensor_preset, &d.lidar, &d.imu));
     }
-    d.odometry = DefaultOdometry(d.lidar, d.imu);
+    d.odometry = DefaultOdometryOptions(d.lidar, d.imu);
     d.bag.point_time_unit = d.lidar.timestamp_unit;
     out.drones.push_back(std::move(d));
   }

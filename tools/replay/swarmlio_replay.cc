@@ -23,6 +23,7 @@
 
 #include "progress_bar.h"
 #include "swarmlio/io/pcd_writer.h"
+#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
 
@@ -73,7 +74,8 @@ Status WriteTum(const std::string& path, const std::vector<replay::ScanRecord>& 
 Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord>& scans) {
   std::ofstream out(path);
   if (!out) return Status::IoError(path + ": cannot open for writing");
-  out << "stamp_s,updated,raw_points,points,correspondences,iterations,map_points,"
+  out << "stamp_s,updated,raw_points,points,correspondences,iterations,min_normal_information,"
+         "degenerate,map_points,"
          "preprocess_ms,propagate_ms,undistort_ms,association_ms,solve_ms,covariance_ms,"
          "map_update_ms,total_ms\n";
   out << std::fixed;
@@ -81,7 +83,8 @@ Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord
     const lio::ScanTimings& t = s.timings;
     out << std::setprecision(9) << StampSeconds(s.stamp_ns) << "," << (s.updated ? 1 : 0) << ","
         << s.num_raw_points << "," << s.num_points << "," << s.num_correspondences << ","
-        << s.iterations << "," << s.map_size << std::setprecision(4) << ","
+        << s.iterations << "," << std::setprecision(2) << s.min_normal_information << ","
+        << (s.degenerate ? 1 : 0) << "," << s.map_size << std::setprecision(4) << ","
         << 1e3 * t.preprocess_s << "," << 1e3 * t.propagate_s << "," << 1e3 * t.undistort_s << ","
         << 1e3 * t.association_s << "," << 1e3 * t.solve_s << "," << 1e3 * t.covariance_s << ","
         << 1e3 * t.map_update_s << "," << 1e3 * t.total_s << "\n";
@@ -104,11 +107,11 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     ++updated;
   }
   const lio::OdometryCounters& c = d.odometry().counters();
-  std::printf("%s: %lld scans processed, %lld updated, %lld dropped before IMU init; "
-              "map %zu points\n",
+  std::printf("%s: %lld scans processed, %lld updated (%lld degenerate), %lld dropped before "
+              "IMU init; map %zu points\n",
               d.input().name.c_str(), static_cast<long long>(c.scans_processed),
-              static_cast<long long>(updated), static_cast<long long>(c.scans_before_init),
-              d.odometry().map_size());
+              static_cast<long long>(updated), static_cast<long long>(c.scans_degenerate),
+              static_cast<long long>(c.scans_before_init), d.odometry().map_size());
   if (!d.odometry().initialized()) {
     std::printf("  IMU never initialized: %s\n", d.odometry().initialization_error().c_str());
   } else {
@@ -140,6 +143,19 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     for (const auto& s : scans) busy_s += s.timings.total_s;
     std::printf("  log %.1f s, estimator busy %.2f s: %.1fx real time (whole replay %.1f s wall)\n",
                 log_s, busy_s, busy_s > 0 ? log_s / busy_s : 0.0, wall_s);
+  }
+  if (!d.bag_ground_truth().empty()) {
+    replay::ConsistencyStats cs;
+    const Status status = replay::EvaluateConsistency(d.scans(), d.bag_ground_truth(), 0.05, &cs);
+    if (status.ok()) {
+      std::printf("  vs bag ground truth (same frame, no alignment), %d poses: position RMSE "
+                  "%.4f m (max %.4f), rotation RMSE %.3f deg, mean position NEES %.2f "
+                  "(expected %.0f)\n",
+                  cs.num_poses, cs.position_rmse_m, cs.position_max_m, cs.rotation_rmse_deg,
+                  cs.mean_position_nees, cs.expected_position_nees);
+    } else {
+      std::printf("  ground truth: %s\n", status.message().c_str());
+    }
   }
   if (d.warnings().count > 0) {
     std::printf("  %lld warnings; first: %s\n", static_cast<long long>(d.warnings().count),

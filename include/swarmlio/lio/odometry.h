@@ -56,6 +56,10 @@ struct ScanOutput {
   int num_correspondences = 0;    // at the last iteration
   int iterations = 0;
   bool converged = false;
+  /// Smallest eigenvalue of sum n n^T over the last correspondences, and
+  /// whether it is below association.degeneracy_threshold.
+  double min_normal_information = 0.0;
+  bool degenerate = false;
   size_t map_size = 0;            // map points after the insertion
   ScanTimings timings;
   std::vector<Eigen::Vector3d> registered_in_G;  // when output_registered_scan
@@ -74,6 +78,7 @@ struct OdometryCounters {
   int64_t scans_dropped_queue = 0;   // dropped: waited too long for IMU data
   int64_t scans_processed = 0;
   int64_t scans_updated = 0;
+  int64_t scans_degenerate = 0;      // updated scans flagged degenerate
   int64_t updates_failed = 0;        // update refused (prediction kept)
 };
 

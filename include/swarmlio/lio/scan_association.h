@@ -8,7 +8,7 @@
 // when the point is close to the plane relative to its range, FAST-LIO's
 // gate  |n^T q + d| < residual_gate_factor * sqrt(|p|)  (FAST-LIO:
 // 1 - 0.9 |z| / sqrt(|p|) > 0.9, i.e. factor 1/9). Weight 1 / sigma^2 with
-// sigma = point_stddev_m.
+// sigma = point_stddev_m (an effective value, see the option).
 //
 // Re-association at every outer iteration: the gate and the residual are
 // re-evaluated at each estimate; the nearest-neighbour search (the expensive
@@ -31,12 +31,33 @@
 
 namespace swarmlio::lio {
 
+/// Plane-fit defaults for scan association, stricter than FAST-LIO's (0.1 m
+/// planarity, 5 m^2 neighbour reach, no collinearity test): with sparse maps
+/// (one Livox Avia scan) looser planes tilted the attitude by ~0.4-1 deg while
+/// static (docs/lio.md, "Plane acceptance").
+inline PlaneFitOptions AssociationPlaneFitDefaults() {
+  PlaneFitOptions options;
+  options.max_point_to_plane_m = 0.05;
+  options.min_plane_extent_m = 0.05;
+  options.max_neighbor_sq_distance_m2 = 1.0;
+  return options;
+}
+
 struct AssociationOptions {
   int num_neighbors = 5;                 // k of the plane fit (NUM_MATCH_POINTS)
-  double point_stddev_m = 0.0316;        // sigma of z: FAST-LIO LASER_POINT_COV 0.001 m^2 [m]
+  // Effective sigma of z [m]: sensor noise plus map / plane-fit errors, which
+  // are shared by neighbouring points (correlated), so far above the range
+  // noise. FAST-LIO's LASER_POINT_COV (0.001 m^2, 0.0316 m) makes the filter
+  // overconfident: position NEES 14-430 on indoor_3uav, 2.7 on average with 0.12 m
+  // (docs/lio.md, "Consistency").
+  double point_stddev_m = 0.12;
   double residual_gate_factor = 1.0 / 9.0;  // keep |z| < factor * sqrt(|p_b|) [sqrt(m)]
   double research_distance_m = 0.05;     // re-search neighbours after moving this far [m]
-  PlaneFitOptions plane;
+  // A scan is flagged degenerate when the smallest eigenvalue of
+  // sum_n n_n n_n^T over its correspondences is below this (Swarm-LIO2
+  // degeneration_thresh: code default 30, 10 in its Mid-360 config) [-].
+  double degeneracy_threshold = 30.0;
+  PlaneFitOptions plane = AssociationPlaneFitDefaults();
 
   template <class V>
   void VisitFields(V&& v) {
@@ -50,6 +71,8 @@ struct AssociationOptions {
     v("research_distance_m", research_distance_m,
       FieldSpec::AtLeast(0.0, "m",
                          "repeat a point's neighbour search when it moved this far; 0 = always"));
+    v("degeneracy_threshold", degeneracy_threshold,
+      FieldSpec::AtLeast(0.0, "", "degenerate scan: smallest eigenvalue of sum n n^T below this"));
     v("plane", plane);
   }
   std::string Validate() const { return config::ValidateFields(*this); }
@@ -61,6 +84,9 @@ struct AssociationStats {
   int num_no_plane = 0;       // too few / too far neighbours, not planar
   int num_gated = 0;          // plane found, residual too large
   int num_correspondences = 0;
+  /// Eigenvalues of sum_n n_n n_n^T over the correspondences, ascending: how
+  /// well the planes constrain the translation in each direction.
+  Eigen::Vector3d normal_information = Eigen::Vector3d::Zero();
 };
 
 class ScanAssociator {

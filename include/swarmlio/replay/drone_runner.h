@@ -30,9 +30,14 @@ struct ScanRecord {
   int num_points = 0;
   int num_correspondences = 0;
   int iterations = 0;
+  double min_normal_information = 0.0;  // see lio::ScanOutput
+  bool degenerate = false;
   size_t map_size = 0;
   lio::ScanTimings timings;
 };
+
+/// The record kept of one estimator output.
+ScanRecord ToScanRecord(const lio::ScanOutput& output);
 
 struct DroneWarnings {
   int64_t count = 0;

@@ -43,6 +43,10 @@ struct SwarmManifest {
   std::vector<DroneInput> drones;
 };
 
+/// Odometry defaults for a drone: lio::OdometryOptionsFor(lidar), with the
+/// IMU initializer's acceleration unit and gravity reference from `imu`.
+lio::OdometryOptions DefaultOdometryOptions(const LidarOptions& lidar, const ImuOptions& imu);
+
 /// Loads and validates a manifest. Errors name file:line: key. Drone names
 /// must be unique and non-empty; bags must be given (existence is checked
 /// when they are opened).

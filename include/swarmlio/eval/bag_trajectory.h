@@ -1,0 +1,21 @@
+// Ground-truth trajectories from ROS1 bags (geometry_msgs/PoseStamped).
+#pragma once
+
+#include <string>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/eval/trajectory.h"
+#include "swarmlio/io/bag_options.h"
+
+namespace swarmlio::eval {
+
+/// Reads every pose on options.ground_truth_topic of the bag at `path` into a
+/// stamped trajectory (stamps = StampSeconds(header stamp), T_G_b from the
+/// pose). BagReader needs the IMU and LiDAR topics of `options` to exist; its
+/// pose checks drop non-finite and non-increasing poses (counted in its
+/// stats). Errors: the bag cannot be read, the topic is absent or empty.
+Status ReadBagGroundTruth(const std::string& path,
+                          const io::BagReaderOptions& options,
+                          Trajectory* trajectory);
+
+}  // namespace swarmlio::eval

@@ -1,0 +1,111 @@
+// Inter-drone messages (plain values; SI units; frames in the names, see
+// docs/conventions.md). Wire encoding and sizes: docs/network.md.
+//
+// Every float field travels as IEEE float32 except stamps (int64 ns) and the
+// global positions p_bj_in_Gj / p_Gj_in_Gi (float64): decoding an encoded
+// message gives back each field rounded to the nearest float32. Covariances
+// travel as upper triangles (row-major: 00 01 02 11 12 22 ...); the encoder
+// reads only the upper triangle and the decoder mirrors it, so decoded
+// covariances are exactly symmetric.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <variant>
+#include <vector>
+
+namespace swarmlio::net {
+
+enum class MessageType : uint8_t {
+  kEgoState = 1,
+  kGlobalExtrinsic = 2,
+  kTimeSync = 3,
+};
+
+const char* MessageTypeName(MessageType type);
+
+/// Sender j saw teammate k (LiDAR cluster of k's reflective tape).
+struct TeammateObservation {
+  int observed_id = 0;                                   // k
+  Eigen::Vector3d p_bk_in_bj = Eigen::Vector3d::Zero();  // k's body origin in j's body frame [m]
+  Eigen::Matrix3d cov_p_bk_in_bj = Eigen::Matrix3d::Zero();  // its covariance [m^2]
+};
+
+/// Drone j's ego state at `stamp_ns` (j's clock), sent after every scan.
+/// The covariance blocks are the ones a receiver k needs for the active and
+/// passive observation terms and for propagating j to k's scan time with
+/// constant velocity + gyro: rotation, position and velocity marginals (the
+/// diagonal 3x3 blocks of j's error-state covariance; cross blocks are not
+/// sent, see docs/network.md).
+struct EgoStateMessage {
+  /// Upper bound on observations per message (keeps the packet <= 1200 B).
+  static constexpr int kMaxObservations = 24;
+
+  int sender_id = 0;             // j
+  int64_t stamp_ns = 0;          // state time, j's clock [ns]
+  int64_t session_start_ns = 0;  // j's estimator start time, j's clock [ns]; a change
+                                 // means j rebooted (drop its tracker and extrinsic)
+  Eigen::Quaterniond q_Gj_bj = Eigen::Quaterniond::Identity();  // attitude (unit)
+  Eigen::Vector3d p_bj_in_Gj = Eigen::Vector3d::Zero();         // [m]
+  Eigen::Vector3d v_bj_in_Gj = Eigen::Vector3d::Zero();         // [m/s]
+  Eigen::Vector3d omega_bj_in_bj = Eigen::Vector3d::Zero();     // unbiased gyro [rad/s]
+  Eigen::Matrix3d cov_theta_Gj_bj = Eigen::Matrix3d::Zero();    // R = R^ Exp(dtheta) [rad^2]
+  Eigen::Matrix3d cov_p_bj_in_Gj = Eigen::Matrix3d::Zero();     // [m^2]
+  Eigen::Matrix3d cov_v_bj_in_Gj = Eigen::Matrix3d::Zero();     // [m^2/s^2]
+  bool degenerated = false;                       // j's last scan was LiDAR-degenerate
+  std::vector<TeammateObservation> observations;  // distinct ids, none == sender_id
+};
+
+/// How the sender obtained a global extrinsic.
+enum class ExtrinsicSource : uint8_t {
+  kTrajectoryMatch = 1,  // its own tracker-vs-odometry trajectory match
+  kGraph = 2,            // derived through the extrinsic graph
+};
+
+/// The sender i's estimate of T_Gi_Gj for one teammate j.
+struct GlobalExtrinsicEntry {
+  int teammate_id = 0;  // j
+  ExtrinsicSource source = ExtrinsicSource::kTrajectoryMatch;
+  Eigen::Quaterniond q_Gi_Gj = Eigen::Quaterniond::Identity();  // unit
+  Eigen::Vector3d p_Gj_in_Gi = Eigen::Vector3d::Zero();         // [m]
+  /// Covariance of [dtheta (rad); dp (m)], R_Gi_Gj = R^ Exp(dtheta) (the
+  /// teammate block order of ErrorStateLayout). Full 6x6: rotation and
+  /// translation of a trajectory match are strongly correlated.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+};
+
+/// Drone i's known global extrinsics. A sender with more entries than
+/// kMaxEntries splits them over several messages (each is self-contained).
+struct GlobalExtrinsicMessage {
+  static constexpr int kMaxEntries = 8;
+
+  int sender_id = 0;                          // i
+  int64_t stamp_ns = 0;                       // i's clock [ns]
+  std::vector<GlobalExtrinsicEntry> entries;  // distinct ids, none == sender_id
+};
+
+/// NTP-style four-timestamp clock sync. The requester sends a request with
+/// t1; the responder answers with t1 echoed, t2 (request receipt) and t3
+/// (response send) on its clock; the requester notes t4 on receipt and
+/// computes offset = ((t2 - t1) + (t3 - t4)) / 2.
+struct TimeSyncMessage {
+  int sender_id = 0;
+  int target_id = 0;  // the drone this request or response is for
+  bool is_response = false;
+  int64_t t1_ns = 0;  // request send time, requester clock
+  int64_t t2_ns = 0;  // request receipt, responder clock (0 in a request)
+  int64_t t3_ns = 0;  // response send, responder clock (0 in a request)
+};
+
+using SwarmMessage = std::variant<EgoStateMessage, GlobalExtrinsicMessage, TimeSyncMessage>;
+
+MessageType TypeOf(const SwarmMessage& message);
+int SenderOf(const SwarmMessage& message);
+
+/// Splits `entries` into messages of at most kMaxEntries entries each (at
+/// least one message, possibly empty), all with the same sender and stamp.
+std::vector<GlobalExtrinsicMessage> SplitGlobalExtrinsics(
+    int sender_id, int64_t stamp_ns, const std::vector<GlobalExtrinsicEntry>& entries);
+
+}  // namespace swarmlio::net

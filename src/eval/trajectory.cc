@@ -1,0 +1,80 @@
+#include "swarmlio/eval/trajectory.h"
+
+#include <cmath>
+#include <string>
+
+namespace swarmlio::eval {
+
+namespace {
+
+// Rotation blocks read from 6-digit KITTI files are orthonormal to ~1e-6.
+constexpr double kMaxOrthonormalityError = 1e-4;
+
+}  // namespace
+
+Eigen::Matrix3Xd Trajectory::Positions() const {
+  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(T_G_b.size()));
+  for (size_t i = 0; i < T_G_b.size(); ++i) {
+    positions.col(static_cast<Eigen::Index>(i)) = T_G_b[i].translation();
+  }
+  return positions;
+}
+
+Trajectory Trajectory::Select(const std::vector<size_t>& ids) const {
+  Trajectory out;
+  out.T_G_b.reserve(ids.size());
+  if (has_stamps()) out.stamps_s.reserve(ids.size());
+  for (const size_t id : ids) {
+    out.T_G_b.push_back(T_G_b.at(id));
+    if (has_stamps()) out.stamps_s.push_back(stamps_s.at(id));
+  }
+  return out;
+}
+
+Trajectory TrajectoryFromPoses(const std::vector<PoseStamped>& poses) {
+  Trajectory out;
+  out.stamps_s.reserve(poses.size());
+  out.T_G_b.reserve(poses.size());
+  for (const PoseStamped& pose : poses) {
+    Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+    T_G_b.linear() = pose.q_G_b.normalized().toRotationMatrix();
+    T_G_b.translation() = pose.p_b_in_G;
+    out.stamps_s.push_back(StampSeconds(pose.stamp_ns));
+    out.T_G_b.push_back(T_G_b);
+  }
+  return out;
+}
+
+Status ValidateTrajectory(const Trajectory& trajectory, const std::string& name) {
+  if (trajectory.has_stamps() && trajectory.stamps_s.size() != trajectory.T_G_b.size()) {
+    return Status::InvalidArgument(name + ": " + std::to_string(trajectory.stamps_s.size()) +
+                                   " stamps for " + std::to_string(trajectory.T_G_b.size()) +
+                                   " poses");
+  }
+  for (size_t i = 0; i < trajectory.stamps_s.size(); ++i) {
+    const double stamp_s = trajectory.stamps_s[i];
+    if (!std::isfinite(stamp_s)) {
+      return Status::InvalidArgument(name + ": pose " + std::to_string(i) +
+                                     " has a non-finite stamp");
+    }
+    if (i > 0 && stamp_s < trajectory.stamps_s[i - 1]) {
+      return Status::InvalidArgument(name + ": stamps decrease at pose " + std::to_string(i));
+    }
+  }
+  for (size_t i = 0; i < trajectory.T_G_b.size(); ++i) {
+    const Eigen::Isometry3d& T = trajectory.T_G_b[i];
+    if (!T.matrix().allFinite()) {
+      return Status::InvalidArgument(name + ": pose " + std::to_string(i) + " is not finite");
+    }
+    const Eigen::Matrix3d R = T.linear();
+    const double orthonormality_error =
+        (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (orthonormality_error > kMaxOrthonormalityError || R.determinant() <= 0.0) {
+      return Status::InvalidArgument(name + ": pose " + std::to_string(i) +
+                                     " has a rotation block that is not a rotation");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace swarmlio::eval

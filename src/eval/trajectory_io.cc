@@ -1,0 +1,248 @@
+#include "swarmlio/eval/trajectory_io.h"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <system_error>
+#include <vector>
+
+namespace swarmlio::eval {
+
+namespace {
+
+constexpr int kTumValues = 8;
+constexpr int kKittiValues = 12;
+// A quaternion this close to zero has no defined rotation.
+constexpr double kMinQuaternionNorm = 1e-9;
+// Same tolerance as ValidateTrajectory (6-digit KITTI files).
+constexpr double kMaxOrthonormalityError = 1e-4;
+
+std::string Where(const std::string& path, int line_number) {
+  return path + ":" + std::to_string(line_number) + ": ";
+}
+
+/// Splits on spaces and tabs. Returns false if the line is a comment or empty.
+bool Tokenize(std::string line, std::vector<std::string>* tokens) {
+  tokens->clear();
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const size_t first = line.find_first_not_of(" \t");
+  if (first == std::string::npos || line[first] == '#') return false;
+  size_t pos = first;
+  while (pos < line.size()) {
+    const size_t end = line.find_first_of(" \t", pos);
+    tokens->push_back(line.substr(pos, end == std::string::npos ? std::string::npos : end - pos));
+    if (end == std::string::npos) break;
+    pos = line.find_first_not_of(" \t", end);
+    if (pos == std::string::npos) break;
+  }
+  return true;
+}
+
+/// Parses exactly `count` finite numbers (locale independent, correctly
+/// rounded like strtod, so the doubles equal numpy's).
+Status ParseNumbers(const std::vector<std::string>& tokens, size_t count, double* values) {
+  if (tokens.size() != count) {
+    return Status::InvalidArgument("expected " + std::to_string(count) + " values, got " +
+                                   std::to_string(tokens.size()));
+  }
+  for (size_t k = 0; k < count; ++k) {
+    const std::string& token = tokens[k];
+    const char* begin = token.data();
+    const char* end = token.data() + token.size();
+    if (begin != end && *begin == '+') ++begin;
+    const std::from_chars_result parsed = std::from_chars(begin, end, values[k]);
+    if (parsed.ec != std::errc() || parsed.ptr != end) {
+      return Status::InvalidArgument("value " + std::to_string(k + 1) + " '" + token +
+                                     "' is not a number");
+    }
+    if (!std::isfinite(values[k])) {
+      return Status::InvalidArgument("value " + std::to_string(k + 1) + " '" + token +
+                                     "' is not finite");
+    }
+  }
+  return Status::Ok();
+}
+
+Status OpenForReading(const std::string& path, std::ifstream* file) {
+  file->open(path);
+  if (!file->is_open()) return Status::NotFound(path + ": cannot open trajectory file");
+  return Status::Ok();
+}
+
+Status FinishReading(const std::string& path, const std::ifstream& file, const Trajectory& out) {
+  if (file.bad()) return Status::IoError(path + ": read error");
+  if (out.empty()) return Status::InvalidArgument(path + ": no poses in file");
+  return Status::Ok();
+}
+
+Status OpenForWriting(const std::string& path, std::FILE** file) {
+  *file = std::fopen(path.c_str(), "w");
+  if (*file == nullptr) return Status::IoError(path + ": cannot open for writing");
+  return Status::Ok();
+}
+
+Status CloseWritten(const std::string& path, std::FILE* file, bool write_ok) {
+  const bool close_ok = std::fclose(file) == 0;
+  if (!write_ok || !close_ok) return Status::IoError(path + ": write failed");
+  return Status::Ok();
+}
+
+}  // namespace
+
+bool TrajectoryFormatFromString(const std::string& text, TrajectoryFormat* format) {
+  if (text == "tum") {
+    *format = TrajectoryFormat::kTum;
+  } else if (text == "kitti") {
+    *format = TrajectoryFormat::kKitti;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+Status ReadTumTrajectory(const std::string& path,
+                         const TrajectoryReadOptions& options,
+                         Trajectory* trajectory,
+                         TrajectoryReadStats* stats) {
+  std::ifstream file;
+  SWARMLIO_RETURN_IF_ERROR(OpenForReading(path, &file));
+  Trajectory out;
+  TrajectoryReadStats counts;
+  std::string line;
+  std::vector<std::string> tokens;
+  int line_number = 0;
+  int previous_line = 0;
+  while (std::getline(file, line)) {
+    ++line_number;
+    if (!Tokenize(line, &tokens)) {
+      ++counts.skipped_lines;
+      continue;
+    }
+    std::array<double, kTumValues> v{};
+    const Status parsed = ParseNumbers(tokens, kTumValues, v.data());
+    if (!parsed.ok()) return Status::InvalidArgument(Where(path, line_number) + parsed.message());
+    const double stamp_s = v[0];
+    if (out.has_stamps()) {
+      const double previous_s = out.stamps_s.back();
+      const bool equal = stamp_s == previous_s;
+      if (stamp_s < previous_s || (equal && !options.allow_duplicate_stamps)) {
+        return Status::InvalidArgument(
+            Where(path, line_number) + "stamp " + tokens[0] + " does not increase (line " +
+            std::to_string(previous_line) + ")" +
+            (equal ? "; equal stamps are accepted with allow_duplicate_stamps" : ""));
+      }
+      if (equal) ++counts.duplicate_stamps;
+    }
+    // File order is x y z w; Eigen's constructor takes w x y z.
+    Eigen::Quaterniond q_G_b(v[7], v[4], v[5], v[6]);
+    if (q_G_b.norm() < kMinQuaternionNorm) {
+      return Status::InvalidArgument(Where(path, line_number) + "zero quaternion");
+    }
+    q_G_b.normalize();
+    Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+    T_G_b.linear() = q_G_b.toRotationMatrix();
+    T_G_b.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    out.stamps_s.push_back(stamp_s);
+    out.T_G_b.push_back(T_G_b);
+    previous_line = line_number;
+  }
+  SWARMLIO_RETURN_IF_ERROR(FinishReading(path, file, out));
+  counts.pose_lines = static_cast<int>(out.size());
+  *trajectory = std::move(out);
+  if (stats != nullptr) *stats = counts;
+  return Status::Ok();
+}
+
+Status ReadKittiTrajectory(const std::string& path,
+                           Trajectory* trajectory,
+                           TrajectoryReadStats* stats) {
+  std::ifstream file;
+  SWARMLIO_RETURN_IF_ERROR(OpenForReading(path, &file));
+  Trajectory out;
+  TrajectoryReadStats counts;
+  std::string line;
+  std::vector<std::string> tokens;
+  int line_number = 0;
+  while (std::getline(file, line)) {
+    ++line_number;
+    if (!Tokenize(line, &tokens)) {
+      ++counts.skipped_lines;
+      continue;
+    }
+    std::array<double, kKittiValues> v{};
+    const Status parsed = ParseNumbers(tokens, kKittiValues, v.data());
+    if (!parsed.ok()) return Status::InvalidArgument(Where(path, line_number) + parsed.message());
+    Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) T_G_b.matrix()(r, c) = v[static_cast<size_t>(4 * r + c)];
+    }
+    const Eigen::Matrix3d R = T_G_b.linear();
+    const double orthonormality_error =
+        (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (orthonormality_error > kMaxOrthonormalityError || R.determinant() <= 0.0) {
+      return Status::InvalidArgument(Where(path, line_number) +
+                                     "the 3 x 3 block is not a rotation (|R^T R - I| = " +
+                                     std::to_string(orthonormality_error) + ")");
+    }
+    out.T_G_b.push_back(T_G_b);
+  }
+  SWARMLIO_RETURN_IF_ERROR(FinishReading(path, file, out));
+  counts.pose_lines = static_cast<int>(out.size());
+  *trajectory = std::move(out);
+  if (stats != nullptr) *stats = counts;
+  return Status::Ok();
+}
+
+Status ReadTrajectory(const std::string& path,
+                      TrajectoryFormat format,
+                      const TrajectoryReadOptions& options,
+                      Trajectory* trajectory,
+                      TrajectoryReadStats* stats) {
+  switch (format) {
+    case TrajectoryFormat::kTum:
+      return ReadTumTrajectory(path, options, trajectory, stats);
+    case TrajectoryFormat::kKitti:
+      return ReadKittiTrajectory(path, trajectory, stats);
+  }
+  return Status::InvalidArgument("unknown trajectory format");
+}
+
+Status WriteTumTrajectory(const std::string& path, const Trajectory& trajectory) {
+  SWARMLIO_RETURN_IF_ERROR(ValidateTrajectory(trajectory, path));
+  if (!trajectory.has_stamps()) {
+    return Status::InvalidArgument(path + ": a TUM file needs stamps; the trajectory has none");
+  }
+  std::FILE* file = nullptr;
+  SWARMLIO_RETURN_IF_ERROR(OpenForWriting(path, &file));
+  bool ok = std::fprintf(file, "# timestamp tx ty tz qx qy qz qw\n") > 0;
+  for (size_t i = 0; ok && i < trajectory.size(); ++i) {
+    const Eigen::Isometry3d& T = trajectory.T_G_b[i];
+    const Eigen::Quaterniond q_G_b(Eigen::Matrix3d(T.linear()));
+    const Eigen::Vector3d& p = T.translation();
+    ok = std::fprintf(file, "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n",
+                      trajectory.stamps_s[i], p.x(), p.y(), p.z(), q_G_b.x(), q_G_b.y(), q_G_b.z(),
+                      q_G_b.w()) > 0;
+  }
+  return CloseWritten(path, file, ok);
+}
+
+Status WriteKittiTrajectory(const std::string& path, const Trajectory& trajectory) {
+  SWARMLIO_RETURN_IF_ERROR(ValidateTrajectory(trajectory, path));
+  std::FILE* file = nullptr;
+  SWARMLIO_RETURN_IF_ERROR(OpenForWriting(path, &file));
+  bool ok = true;
+  for (size_t i = 0; ok && i < trajectory.size(); ++i) {
+    const Eigen::Matrix4d& M = trajectory.T_G_b[i].matrix();
+    for (int r = 0; ok && r < 3; ++r) {
+      for (int c = 0; ok && c < 4; ++c) {
+        ok = std::fprintf(file, (r == 2 && c == 3) ? "%.17g\n" : "%.17g ", M(r, c)) > 0;
+      }
+    }
+  }
+  return CloseWritten(path, file, ok);
+}
+
+}  // namespace swarmlio::eval

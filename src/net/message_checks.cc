@@ -1,0 +1,178 @@
+// CheckMessage: the semantic rules shared by Encode and Decode.
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "swarmlio/net/packet_codec.h"
+#include "swarmlio/net/swarm_limits.h"
+
+namespace swarmlio::net {
+namespace {
+
+// |norm - 1| bound for a transmitted unit quaternion (float32 rounding is ~1e-7).
+constexpr double kUnitQuaternionTolerance = 1e-3;
+
+/// Collects the first violated rule. Field names are `const char*` plus an
+/// optional index and the current list-entry context; the text is built only
+/// when a rule fails (this runs for every packet sent and received).
+class Checker {
+ public:
+  explicit Checker(const char* type) : type_(type) {}
+
+  bool ok() const { return error_.empty(); }
+  Status status() const {
+    return ok() ? Status::Ok() : Status::InvalidArgument(std::string(type_) + ": " + error_);
+  }
+
+  /// Prefix for the following fields, e.g. "observations[2]." ("" to clear).
+  void SetContext(std::string context) { context_ = std::move(context); }
+
+  void Fail(const char* field, int index, const std::string& reason) {
+    if (!ok()) return;
+    error_ = "field '" + context_ + field;
+    if (index >= 0) error_ += "[" + std::to_string(index) + "]";
+    error_ += "' " + reason;
+  }
+
+  void Id(const char* field, int id) {
+    if (!IsValidDroneId(id)) {
+      Fail(field, -1,
+           "= " + std::to_string(id) + " is not a drone id (0.." +
+               std::to_string(kMaxSwarmSize - 1) + ")");
+    }
+  }
+  void Stamp(const char* field, int64_t stamp_ns) {
+    if (stamp_ns < 0) Fail(field, -1, "is negative");
+  }
+  /// Finite and representable as a float32 (it travels as one).
+  void F32(const char* field, int index, double v) {
+    if (!std::isfinite(v) || std::abs(v) > std::numeric_limits<float>::max()) {
+      Fail(field, index, "is not a finite float32");
+    }
+  }
+  void Vector32(const char* field, const Eigen::Vector3d& v) {
+    for (int i = 0; i < 3; ++i) F32(field, i, v[i]);
+  }
+  void Vector64(const char* field, const Eigen::Vector3d& v) {
+    for (int i = 0; i < 3; ++i) {
+      if (!std::isfinite(v[i])) Fail(field, i, "is not finite");
+    }
+  }
+  /// The norm is taken of the float32-rounded coefficients, as they travel.
+  void UnitQuaternion(const char* field, const Eigen::Quaterniond& q) {
+    const Eigen::Vector4d c = q.coeffs();
+    double norm2 = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      F32(field, i, c[i]);
+      const double rounded = static_cast<double>(static_cast<float>(c[i]));
+      norm2 += rounded * rounded;
+    }
+    if (ok() && std::abs(std::sqrt(norm2) - 1.0) > kUnitQuaternionTolerance) {
+      Fail(field, -1, "is not a unit quaternion (norm " + std::to_string(std::sqrt(norm2)) + ")");
+    }
+  }
+  /// Upper triangle finite in float32, diagonal >= 0.
+  template <int N>
+  void Covariance(const char* field, const Eigen::Matrix<double, N, N>& m) {
+    for (int row = 0; row < N; ++row) {
+      for (int col = row; col < N; ++col) F32(field, -1, m(row, col));
+      if (m(row, row) < 0.0) {
+        Fail(
+            field, -1,
+            "has a negative variance at (" + std::to_string(row) + "," + std::to_string(row) + ")");
+      }
+    }
+  }
+  /// Teammate ids of one list: valid, not the sender, pairwise distinct.
+  void TeammateId(const char* field, int id, int sender_id, uint64_t* seen) {
+    Id(field, id);
+    if (!ok()) return;
+    if (id == sender_id) Fail(field, -1, "= " + std::to_string(id) + " is the sender itself");
+    const uint64_t bit = uint64_t{1} << id;
+    if (ok() && (*seen & bit) != 0) Fail(field, -1, "= " + std::to_string(id) + " is repeated");
+    *seen |= bit;
+  }
+
+ private:
+  const char* type_;
+  std::string context_;
+  std::string error_;
+};
+
+static_assert(kMaxSwarmSize <= 64, "TeammateId tracks ids in a 64-bit mask");
+
+Status Check(const EgoStateMessage& m) {
+  Checker c("EgoState");
+  c.Id("sender_id", m.sender_id);
+  c.Stamp("stamp_ns", m.stamp_ns);
+  c.Stamp("session_start_ns", m.session_start_ns);
+  c.UnitQuaternion("q_Gj_bj", m.q_Gj_bj);
+  c.Vector64("p_bj_in_Gj", m.p_bj_in_Gj);
+  c.Vector32("v_bj_in_Gj", m.v_bj_in_Gj);
+  c.Vector32("omega_bj_in_bj", m.omega_bj_in_bj);
+  c.Covariance<3>("cov_theta_Gj_bj", m.cov_theta_Gj_bj);
+  c.Covariance<3>("cov_p_bj_in_Gj", m.cov_p_bj_in_Gj);
+  c.Covariance<3>("cov_v_bj_in_Gj", m.cov_v_bj_in_Gj);
+  if (m.observations.size() > static_cast<size_t>(EgoStateMessage::kMaxObservations)) {
+    c.Fail("observations", -1,
+           "has " + std::to_string(m.observations.size()) + " entries, more than the maximum " +
+               std::to_string(EgoStateMessage::kMaxObservations));
+  }
+  uint64_t seen = 0;
+  for (size_t i = 0; i < m.observations.size() && c.ok(); ++i) {
+    c.SetContext("observations[" + std::to_string(i) + "].");
+    const TeammateObservation& o = m.observations[i];
+    c.TeammateId("observed_id", o.observed_id, m.sender_id, &seen);
+    c.Vector32("p_bk_in_bj", o.p_bk_in_bj);
+    c.Covariance<3>("cov_p_bk_in_bj", o.cov_p_bk_in_bj);
+  }
+  return c.status();
+}
+
+Status Check(const GlobalExtrinsicMessage& m) {
+  Checker c("GlobalExtrinsic");
+  c.Id("sender_id", m.sender_id);
+  c.Stamp("stamp_ns", m.stamp_ns);
+  if (m.entries.size() > static_cast<size_t>(GlobalExtrinsicMessage::kMaxEntries)) {
+    c.Fail("entries", -1,
+           "has " + std::to_string(m.entries.size()) + " entries, more than the maximum " +
+               std::to_string(GlobalExtrinsicMessage::kMaxEntries) +
+               " (use SplitGlobalExtrinsics)");
+  }
+  uint64_t seen = 0;
+  for (size_t i = 0; i < m.entries.size() && c.ok(); ++i) {
+    c.SetContext("entries[" + std::to_string(i) + "].");
+    const GlobalExtrinsicEntry& e = m.entries[i];
+    c.TeammateId("teammate_id", e.teammate_id, m.sender_id, &seen);
+    if (e.source != ExtrinsicSource::kTrajectoryMatch && e.source != ExtrinsicSource::kGraph) {
+      c.Fail("source", -1, "has an unknown value");
+    }
+    c.UnitQuaternion("q_Gi_Gj", e.q_Gi_Gj);
+    c.Vector64("p_Gj_in_Gi", e.p_Gj_in_Gi);
+    c.Covariance<6>("covariance", e.covariance);
+  }
+  return c.status();
+}
+
+Status Check(const TimeSyncMessage& m) {
+  Checker c("TimeSync");
+  c.Id("sender_id", m.sender_id);
+  c.Id("target_id", m.target_id);
+  if (c.ok() && m.target_id == m.sender_id) c.Fail("target_id", -1, "is the sender itself");
+  c.Stamp("t1_ns", m.t1_ns);
+  c.Stamp("t2_ns", m.t2_ns);
+  c.Stamp("t3_ns", m.t3_ns);
+  if (!m.is_response && (m.t2_ns != 0 || m.t3_ns != 0)) {
+    c.Fail("t2_ns", -1, "and t3_ns must be 0 in a request");
+  }
+  return c.status();
+}
+
+}  // namespace
+
+Status CheckMessage(const SwarmMessage& message) {
+  return std::visit([](const auto& m) { return Check(m); }, message);
+}
+
+}  // namespace swarmlio::net

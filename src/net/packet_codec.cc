@@ -1,0 +1,145 @@
+// PacketCodec: header, authentication tag and dispatch to the payload codecs.
+#include "swarmlio/net/packet_codec.h"
+
+#include <sodium.h>
+
+#include <string>
+#include <type_traits>
+
+#include "src/net/payload_codecs.h"
+#include "src/net/wire_reader.h"
+#include "src/net/wire_writer.h"
+
+namespace swarmlio::net {
+
+static_assert(kTagBytes == crypto_auth_BYTES, "tag size is HMAC-SHA512-256's");
+
+Status PacketCodec::Create(const SwarmKey& key, PacketCodec* codec) {
+  if (sodium_init() < 0) return Status::Internal("libsodium failed to initialise");
+  codec->key_ = key;
+  codec->ready_ = true;
+  return Status::Ok();
+}
+
+Status PacketCodec::Encode(const SwarmMessage& message,
+                           uint32_t sequence,
+                           std::vector<uint8_t>* packet) const {
+  if (!ready_) return Status::FailedPrecondition("PacketCodec used before Create()");
+  SWARMLIO_RETURN_IF_ERROR(CheckMessage(message));
+
+  std::vector<uint8_t> bytes;
+  bytes.reserve(kMaxPacketBytes);
+  internal::WireWriter w(&bytes);
+  w.U8(kMagic0);
+  w.U8(kMagic1);
+  w.U8(kProtocolVersion);
+  w.U8(static_cast<uint8_t>(TypeOf(message)));
+  w.U8(static_cast<uint8_t>(SenderOf(message)));
+  w.U8(0);  // flags
+  w.U32(sequence);
+  w.U16(0);  // payload length, patched below
+  std::visit(
+      [&w](const auto& m) {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, EgoStateMessage>) {
+          internal::EncodeEgoState(m, &w);
+        } else if constexpr (std::is_same_v<T, GlobalExtrinsicMessage>) {
+          internal::EncodeGlobalExtrinsic(m, &w);
+        } else {
+          internal::EncodeTimeSync(m, &w);
+        }
+      },
+      message);
+  const size_t payload = bytes.size() - kHeaderBytes;
+  if (payload + kPacketOverheadBytes > kMaxPacketBytes) {  // unreachable: per-type caps
+    return Status::Internal("encoded packet exceeds " + std::to_string(kMaxPacketBytes) + " bytes");
+  }
+  bytes[10] = static_cast<uint8_t>(payload & 0xFF);
+  bytes[11] = static_cast<uint8_t>(payload >> 8);
+  bytes.resize(bytes.size() + kTagBytes);
+  crypto_auth(bytes.data() + kHeaderBytes + payload, bytes.data(), kHeaderBytes + payload,
+              key_.data());
+  *packet = std::move(bytes);
+  return Status::Ok();
+}
+
+Status PacketCodec::Decode(const uint8_t* data, size_t size, DecodedPacket* packet) const {
+  if (!ready_) return Status::FailedPrecondition("PacketCodec used before Create()");
+  if (size < kPacketOverheadBytes) {
+    return Status::DataLoss("packet of " + std::to_string(size) +
+                            " bytes is shorter than header + tag (" +
+                            std::to_string(kPacketOverheadBytes) + ")");
+  }
+  if (size > kMaxPacketBytes) {
+    return Status::DataLoss("packet of " + std::to_string(size) + " bytes exceeds the cap of " +
+                            std::to_string(kMaxPacketBytes));
+  }
+  internal::WireReader header_reader(data, kHeaderBytes);
+  uint8_t magic0 = 0, magic1 = 0, version = 0, type = 0, sender = 0, flags = 0;
+  PacketHeader header;
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("magic", &magic0));
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("magic", &magic1));
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("version", &version));
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("type", &type));
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("sender", &sender));
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("flags", &flags));
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U32("sequence", &header.sequence));
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U16("payload length", &header.payload_bytes));
+  if (magic0 != kMagic0 || magic1 != kMagic1) {
+    return Status::DataLoss("not a swarm packet (bad magic)");
+  }
+  if (version != kProtocolVersion) {
+    return Status::InvalidArgument("unsupported protocol version " + std::to_string(version) +
+                                   " (this build speaks " + std::to_string(kProtocolVersion) + ")");
+  }
+  if (type < static_cast<uint8_t>(MessageType::kEgoState) ||
+      type > static_cast<uint8_t>(MessageType::kTimeSync)) {
+    return Status::InvalidArgument("unknown message type " + std::to_string(type));
+  }
+  if (flags != 0) return Status::DataLoss("header flags must be 0, got " + std::to_string(flags));
+  if (!IsValidDroneId(sender)) {
+    return Status::DataLoss("sender id " + std::to_string(sender) + " out of range");
+  }
+  if (kPacketOverheadBytes + header.payload_bytes != size) {
+    return Status::DataLoss("payload length " + std::to_string(header.payload_bytes) +
+                            " does not match the packet size " + std::to_string(size));
+  }
+  const size_t signed_bytes = kHeaderBytes + header.payload_bytes;
+  if (crypto_auth_verify(data + signed_bytes, data, signed_bytes, key_.data()) != 0) {
+    return Status::DataLoss("authentication tag mismatch (wrong swarm key or corrupted packet)");
+  }
+  header.version = version;
+  header.type = static_cast<MessageType>(type);
+  header.sender_id = sender;
+
+  internal::WireReader r(data + kHeaderBytes, header.payload_bytes);
+  DecodedPacket decoded;
+  decoded.header = header;
+  switch (header.type) {
+    case MessageType::kEgoState: {
+      EgoStateMessage m;
+      SWARMLIO_RETURN_IF_ERROR(internal::DecodeEgoState(sender, &r, &m).WithContext("EgoState"));
+      decoded.message = std::move(m);
+      break;
+    }
+    case MessageType::kGlobalExtrinsic: {
+      GlobalExtrinsicMessage m;
+      SWARMLIO_RETURN_IF_ERROR(
+          internal::DecodeGlobalExtrinsic(sender, &r, &m).WithContext("GlobalExtrinsic"));
+      decoded.message = std::move(m);
+      break;
+    }
+    case MessageType::kTimeSync: {
+      TimeSyncMessage m;
+      SWARMLIO_RETURN_IF_ERROR(internal::DecodeTimeSync(sender, &r, &m).WithContext("TimeSync"));
+      decoded.message = m;
+      break;
+    }
+  }
+  const Status semantic = CheckMessage(decoded.message);
+  if (!semantic.ok()) return Status::DataLoss(semantic.message());
+  *packet = std::move(decoded);
+  return Status::Ok();
+}
+
+}  // namespace swarmlio::net

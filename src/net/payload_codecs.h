@@ -1,0 +1,28 @@
+// Payload encoders and decoders, one pair per message type (the packet
+// header and tag are handled by packet_codec.cc). Encoders assume the message
+// passed CheckMessage; decoders check sizes, counts and finiteness while
+// reading, and leave semantic checks (ids, quaternions, variances) to
+// CheckMessage.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "src/net/wire_reader.h"
+#include "src/net/wire_writer.h"
+#include "swarmlio/common/status.h"
+#include "swarmlio/net/messages.h"
+
+namespace swarmlio::net::internal {
+
+void EncodeEgoState(const EgoStateMessage& message, WireWriter* w);
+/// `sender_id` comes from the packet header.
+Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* message);
+
+void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& message, WireWriter* w);
+Status DecodeGlobalExtrinsic(int sender_id, WireReader* r, GlobalExtrinsicMessage* message);
+
+void EncodeTimeSync(const TimeSyncMessage& message, WireWriter* w);
+Status DecodeTimeSync(int sender_id, WireReader* r, TimeSyncMessage* message);
+
+}  // namespace swarmlio::net::internal

@@ -1,0 +1,103 @@
+// Bounds-checked reader of little-endian swarm packet bytes.
+//
+// Every read checks the remaining byte count first and every float read
+// rejects NaN and Inf, so a decoder built on it cannot overrun its buffer or
+// let a non-finite value into the estimator. Errors are DataLoss Status values
+// naming the field and the offset.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+
+#include "swarmlio/common/status.h"
+
+namespace swarmlio::net::internal {
+
+class WireReader {
+ public:
+  WireReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+
+  size_t position() const { return position_; }
+  size_t remaining() const { return size_ - position_; }
+
+  // `field` names the value in error messages, "field[index]" when index >= 0;
+  // the text is built only on error (decoding is on the per-packet hot path).
+  Status U8(const char* field, uint8_t* value) {
+    SWARMLIO_RETURN_IF_ERROR(Require(field, -1, 1));
+    *value = data_[position_++];
+    return Status::Ok();
+  }
+  Status U16(const char* field, uint16_t* value) { return Get(field, -1, value); }
+  Status U32(const char* field, uint32_t* value) { return Get(field, -1, value); }
+  Status I64(const char* field, int64_t* value) {
+    uint64_t bits = 0;
+    SWARMLIO_RETURN_IF_ERROR(Get(field, -1, &bits));
+    *value = static_cast<int64_t>(bits);
+    return Status::Ok();
+  }
+  /// A float32, widened exactly to double; NaN/Inf rejected.
+  Status F32(const char* field, int index, double* value) {
+    uint32_t bits = 0;
+    SWARMLIO_RETURN_IF_ERROR(Get(field, index, &bits));
+    float f;
+    std::memcpy(&f, &bits, sizeof(f));
+    return Finite(field, index, static_cast<double>(f), value);
+  }
+  Status F64(const char* field, int index, double* value) {
+    uint64_t bits = 0;
+    SWARMLIO_RETURN_IF_ERROR(Get(field, index, &bits));
+    double d;
+    std::memcpy(&d, &bits, sizeof(d));
+    return Finite(field, index, d, value);
+  }
+
+  /// Fails unless every byte was consumed.
+  Status ExpectEnd(const char* what) const {
+    if (remaining() == 0) return Status::Ok();
+    return Status::DataLoss(std::string(what) + ": " + std::to_string(remaining()) +
+                            " trailing bytes after offset " + std::to_string(position_));
+  }
+
+ private:
+  static std::string Name(const char* field, int index) {
+    return index < 0 ? std::string(field) : std::string(field) + "[" + std::to_string(index) + "]";
+  }
+
+  template <class UInt>
+  Status Get(const char* field, int index, UInt* value) {
+    SWARMLIO_RETURN_IF_ERROR(Require(field, index, sizeof(UInt)));
+    UInt v = 0;
+    for (size_t i = 0; i < sizeof(UInt); ++i) {
+      v = static_cast<UInt>(v | (static_cast<UInt>(data_[position_ + i]) << (8 * i)));
+    }
+    position_ += sizeof(UInt);
+    *value = v;
+    return Status::Ok();
+  }
+
+  Status Finite(const char* field, int index, double v, double* value) const {
+    if (!std::isfinite(v)) {
+      return Status::DataLoss("field '" + Name(field, index) + "' is not finite (offset " +
+                              std::to_string(position_) + ")");
+    }
+    *value = v;
+    return Status::Ok();
+  }
+
+  Status Require(const char* field, int index, size_t count) const {
+    if (count <= remaining()) return Status::Ok();
+    return Status::DataLoss("truncated reading field '" + Name(field, index) + "': need " +
+                            std::to_string(count) + " bytes at offset " +
+                            std::to_string(position_) + ", " + std::to_string(remaining()) +
+                            " remain");
+  }
+
+  const uint8_t* data_;
+  size_t size_;
+  size_t position_ = 0;
+};
+
+}  // namespace swarmlio::net::internal

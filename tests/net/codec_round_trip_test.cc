@@ -1,0 +1,196 @@
+// Round trips, sizes and the header layout of the packet codec.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "swarmlio/net/packet_codec.h"
+#include "swarmlio/net/wire_format.h"
+#include "tests/net/net_test_util.h"
+
+namespace swarmlio::net {
+namespace {
+
+using net_test::AllExampleMessages;
+using net_test::ExpectSameMessage;
+using net_test::MakeCodec;
+using net_test::MakeEgoState;
+using net_test::MakeGlobalExtrinsic;
+using net_test::MakeTimeSync;
+
+size_t ExpectedPacketBytes(const SwarmMessage& m) {
+  if (const auto* e = std::get_if<EgoStateMessage>(&m)) {
+    return EgoStatePacketBytes(e->observations.size());
+  }
+  if (const auto* g = std::get_if<GlobalExtrinsicMessage>(&m)) {
+    return GlobalExtrinsicPacketBytes(g->entries.size());
+  }
+  return TimeSyncPacketBytes();
+}
+
+TEST(PacketCodec, EveryMessageRoundTripsBitExactly) {
+  const PacketCodec codec = MakeCodec();
+  uint32_t sequence = 0xFFFFFFF0u;  // also exercises the high bytes
+  for (const SwarmMessage& message : AllExampleMessages()) {
+    SCOPED_TRACE(MessageTypeName(TypeOf(message)));
+    std::vector<uint8_t> packet;
+    ASSERT_TRUE(codec.Encode(message, sequence, &packet).ok());
+    EXPECT_EQ(packet.size(), ExpectedPacketBytes(message));
+    EXPECT_LE(packet.size(), kMaxPacketBytes);
+
+    DecodedPacket decoded;
+    const Status s = codec.Decode(packet.data(), packet.size(), &decoded);
+    ASSERT_TRUE(s.ok()) << s.message();
+    EXPECT_EQ(decoded.header.version, kProtocolVersion);
+    EXPECT_EQ(decoded.header.type, TypeOf(message));
+    EXPECT_EQ(decoded.header.sender_id, SenderOf(message));
+    EXPECT_EQ(decoded.header.sequence, sequence);
+    EXPECT_EQ(decoded.header.payload_bytes, packet.size() - kPacketOverheadBytes);
+    ExpectSameMessage(message, decoded.message);
+
+    std::vector<uint8_t> again;
+    ASSERT_TRUE(codec.Encode(decoded.message, sequence, &again).ok());
+    EXPECT_EQ(again, packet);
+    ++sequence;
+  }
+}
+
+TEST(PacketCodec, DocumentedSizes) {
+  // docs/network.md, "Message sizes".
+  EXPECT_EQ(EgoStatePacketBytes(0), 198u);
+  EXPECT_EQ(EgoStatePacketBytes(1), 235u);
+  EXPECT_EQ(EgoStatePacketBytes(4), 346u);
+  EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 1086u);
+  EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 179u);
+  EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 1061u);
+  EXPECT_EQ(TimeSyncPacketBytes(), 70u);
+}
+
+TEST(PacketCodec, HeaderIsLittleEndianAndPacked) {
+  const PacketCodec codec = MakeCodec();
+  std::vector<uint8_t> packet;
+  ASSERT_TRUE(codec.Encode(MakeTimeSync(5, 9, false), 0x04030201u, &packet).ok());
+  const std::vector<uint8_t> header(packet.begin(), packet.begin() + kHeaderBytes);
+  const std::vector<uint8_t> expected = {
+      'S', 'L', 1, 3, 5, 0, 0x01, 0x02, 0x03, 0x04, static_cast<uint8_t>(kTimeSyncBytes), 0};
+  EXPECT_EQ(header, expected);
+  // Payload: target, kind, then t1 little endian.
+  EXPECT_EQ(packet[12], 9);
+  EXPECT_EQ(packet[13], 0);
+  const int64_t t1 = 1'000'000'123;
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(packet[14 + i], static_cast<uint8_t>(t1 >> (8 * i)));
+}
+
+TEST(PacketCodec, FloatFieldsRoundToFloat32AndGlobalPositionsStayDouble) {
+  const PacketCodec codec = MakeCodec();
+  EgoStateMessage m = MakeEgoState(1, 1, 3);
+  m.v_bj_in_Gj = Eigen::Vector3d(0.1, 1.0 / 3.0, -2.7);
+  m.p_bj_in_Gj = Eigen::Vector3d(1234.56789012345, -0.1, 1.0 / 3.0);
+  m.cov_p_bj_in_Gj(1, 0) = 123.0;  // lower triangle is ignored
+  std::vector<uint8_t> packet;
+  ASSERT_TRUE(codec.Encode(m, 0, &packet).ok());
+  DecodedPacket decoded;
+  ASSERT_TRUE(codec.Decode(packet.data(), packet.size(), &decoded).ok());
+  const auto& d = std::get<EgoStateMessage>(decoded.message);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(d.v_bj_in_Gj[i], net_test::RoundToFloat(m.v_bj_in_Gj[i]));
+  }
+  EXPECT_EQ(d.p_bj_in_Gj, m.p_bj_in_Gj);
+  EXPECT_EQ(d.cov_p_bj_in_Gj(1, 0), m.cov_p_bj_in_Gj(0, 1));
+}
+
+TEST(PacketCodec, EncodeRejectsInvalidMessages) {
+  const PacketCodec codec = MakeCodec();
+  std::vector<uint8_t> packet;
+  auto expect_rejected = [&](const SwarmMessage& m, const std::string& field) {
+    const Status s = codec.Encode(m, 0, &packet);
+    EXPECT_EQ(s.code(), Status::Code::kInvalidArgument) << field;
+    EXPECT_NE(s.message().find(field), std::string::npos) << s.message();
+  };
+  EgoStateMessage e = MakeEgoState(2, 2, 1);
+  e.v_bj_in_Gj.x() = std::numeric_limits<double>::quiet_NaN();
+  expect_rejected(e, "v_bj_in_Gj[0]");
+  e = MakeEgoState(2, 2, 1);
+  e.omega_bj_in_bj.z() = 1e39;  // overflows float32
+  expect_rejected(e, "omega_bj_in_bj[2]");
+  e = MakeEgoState(2, 2, 1);
+  e.p_bj_in_Gj.y() = std::numeric_limits<double>::infinity();
+  expect_rejected(e, "p_bj_in_Gj[1]");
+  e = MakeEgoState(2, 2, 1);
+  e.q_Gj_bj.coeffs() *= 1.01;
+  expect_rejected(e, "q_Gj_bj");
+  e = MakeEgoState(2, 2, 1);
+  e.cov_v_bj_in_Gj(2, 2) = -1e-3;
+  expect_rejected(e, "cov_v_bj_in_Gj");
+  e = MakeEgoState(64, 0, 1);
+  expect_rejected(e, "sender_id");
+  e = MakeEgoState(2, 2, 1);
+  e.observations[1].observed_id = e.observations[0].observed_id;
+  expect_rejected(e, "observations[1].observed_id");
+  e = MakeEgoState(2, 2, 1);
+  e.observations[0].observed_id = 2;
+  expect_rejected(e, "observations[0].observed_id");
+  e = MakeEgoState(2, EgoStateMessage::kMaxObservations + 1, 1);
+  expect_rejected(e, "observations");
+  e = MakeEgoState(2, 0, 1);
+  e.stamp_ns = -1;
+  expect_rejected(e, "stamp_ns");
+
+  GlobalExtrinsicMessage g = MakeGlobalExtrinsic(0, GlobalExtrinsicMessage::kMaxEntries + 1, 1);
+  expect_rejected(g, "SplitGlobalExtrinsics");
+  g = MakeGlobalExtrinsic(0, 1, 1);
+  g.entries[0].source = static_cast<ExtrinsicSource>(7);
+  expect_rejected(g, "entries[0].source");
+  g = MakeGlobalExtrinsic(0, 1, 1);
+  g.entries[0].teammate_id = -1;
+  expect_rejected(g, "entries[0].teammate_id");
+
+  TimeSyncMessage t = MakeTimeSync(1, 1, false);
+  expect_rejected(t, "target_id");
+  t = MakeTimeSync(1, 2, false);
+  t.t2_ns = 5;
+  expect_rejected(t, "t2_ns");
+}
+
+TEST(PacketCodec, UncreatedCodecFails) {
+  const PacketCodec codec;
+  std::vector<uint8_t> packet;
+  EXPECT_EQ(codec.Encode(MakeTimeSync(0, 1, false), 0, &packet).code(),
+            Status::Code::kFailedPrecondition);
+  DecodedPacket decoded;
+  EXPECT_EQ(codec.Decode(packet.data(), packet.size(), &decoded).code(),
+            Status::Code::kFailedPrecondition);
+}
+
+TEST(SplitGlobalExtrinsics, ChunksAtTheCap) {
+  const auto entries = MakeGlobalExtrinsic(0, 20, 5).entries;
+  const auto messages = SplitGlobalExtrinsics(0, 77, entries);
+  ASSERT_EQ(messages.size(), 3u);
+  EXPECT_EQ(messages[0].entries.size(), 8u);
+  EXPECT_EQ(messages[1].entries.size(), 8u);
+  EXPECT_EQ(messages[2].entries.size(), 4u);
+  EXPECT_EQ(messages[2].entries[3].teammate_id, entries[19].teammate_id);
+  EXPECT_EQ(messages[1].stamp_ns, 77);
+  const PacketCodec codec = MakeCodec();
+  for (const auto& m : messages) {
+    std::vector<uint8_t> packet;
+    EXPECT_TRUE(codec.Encode(m, 0, &packet).ok());
+  }
+  const auto none = SplitGlobalExtrinsics(4, 1, {});
+  ASSERT_EQ(none.size(), 1u);
+  EXPECT_TRUE(none[0].entries.empty());
+}
+
+TEST(SwarmKey, FromHex) {
+  SwarmKey key;
+  const std::string hex = "  00112233445566778899aabbccddeeff00112233445566778899AABBCCDDEEFF\n";
+  ASSERT_TRUE(SwarmKey::FromHex(hex, &key).ok());
+  EXPECT_EQ(key.data()[1], 0x11);
+  EXPECT_EQ(key.data()[31], 0xFF);
+  EXPECT_FALSE(SwarmKey::FromHex("0011", &key).ok());
+  EXPECT_FALSE(SwarmKey::FromHex(std::string(63, '0') + "g", &key).ok());
+  const uint8_t short_key[3] = {1, 2, 3};
+  EXPECT_FALSE(SwarmKey::FromBytes(short_key, sizeof(short_key), &key).ok());
+}
+
+}  // namespace
+}  // namespace swarmlio::net

@@ -1,0 +1,82 @@
+#include "swarmlio/replay/manifest.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace swarmlio::replay {
+namespace {
+
+const std::string kPresets = std::string(SWARMLIO_SOURCE_DIR) + "/configs/";
+
+TEST(Manifest, ReadsDronesPresetsAndOverrides) {
+  const std::string yaml =
+      "name: flight\n"
+      "drones:\n"
+      "  - name: a\n"
+      "    bag: logs/a.bag\n"
+      "    ground_truth: a_gt.txt\n"
+      "    sensor_preset: " + kPresets + "livox_avia.yaml\n"
+      "    lidar: {blind_range_m: 1.5}\n"
+      "    imu: {acceleration_unit: g}\n"
+      "    odometry: {imu_time_offset_s: 0.002, association: {num_neighbors: 6}}\n"
+      "  - name: b\n"
+      "    bag: /abs/b.bag\n"
+      "    sensor_preset: " + kPresets + "livox_mid360.yaml\n"
+      "    bag_topics: {imu_topic: /mavros/imu/data}\n";
+  SwarmManifest m;
+  const Status status = ParseManifest(yaml, "/data/run/swarm.yaml", &m);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(m.drones.size(), 2u);
+  EXPECT_EQ(m.name, "flight");
+  EXPECT_EQ(m.drones[0].bag_path, "/data/run/logs/a.bag");
+  EXPECT_EQ(m.drones[0].ground_truth_path, "/data/run/a_gt.txt");
+  EXPECT_EQ(m.drones[0].lidar.type, LidarType::kLivoxAvia);
+  EXPECT_EQ(m.drones[0].lidar.blind_range_m, 1.5);
+  EXPECT_EQ(m.drones[0].odometry.imu_time_offset_s, 0.002);
+  EXPECT_EQ(m.drones[0].odometry.association.num_neighbors, 6);
+  // Sensor-dependent defaults survive the overrides.
+  EXPECT_EQ(m.drones[0].odometry.map.leaf_size_m, 0.25);
+  EXPECT_EQ(m.drones[0].odometry.imu_init.acceleration_unit,
+            AccelerationUnitSetting::kStandardGravity);
+  EXPECT_EQ(m.drones[1].bag_path, "/abs/b.bag");
+  EXPECT_EQ(m.drones[1].ground_truth_path, "");
+  EXPECT_EQ(m.drones[1].bag.imu_topic, "/mavros/imu/data");
+  EXPECT_EQ(m.drones[1].odometry.map.leaf_size_m, 0.3);
+}
+
+TEST(Manifest, RejectsBadEntriesWithFileLineAndKey) {
+  struct Bad {
+    std::string yaml;
+    std::string expect;
+  };
+  const Bad cases[] = {
+      {"drones: []\n", "at least one drone"},
+      {"drones:\n  - {name: a}\n", "bag"},
+      {"drones:\n  - {name: a, bag: x.bag}\n  - {name: a, bag: y.bag}\n", "duplicate"},
+      {"drones:\n  - {name: a, bag: x.bag, odometry: {min_scan_pointz: 3}}\n", "min_scan_pointz"},
+      {"drones:\n  - {name: a, bag: x.bag, odometry: {min_scan_points: -3}}\n", "min_scan_points"},
+      {"drones:\n  - {name: a, bag: x.bag, sensor_preset: /no/such.yaml}\n", "sensor_preset"},
+  };
+  for (const Bad& c : cases) {
+    SwarmManifest m;
+    const Status status = ParseManifest(c.yaml, "m.yaml", &m);
+    EXPECT_FALSE(status.ok()) << c.yaml;
+    EXPECT_NE(status.message().find(c.expect), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("m.yaml"), std::string::npos) << status.message();
+  }
+}
+
+TEST(Manifest, FromBags) {
+  SwarmManifest m;
+  ASSERT_TRUE(ManifestFromBags({"x.bag", "y.bag"}, kPresets + "livox_mid360.yaml", {}, &m).ok());
+  ASSERT_EQ(m.drones.size(), 2u);
+  EXPECT_EQ(m.drones[1].name, "uav2");
+  EXPECT_EQ(m.drones[1].lidar.type, LidarType::kLivoxMid360);
+  EXPECT_FALSE(ManifestFromBags({}, "", {}, &m).ok());
+  EXPECT_FALSE(ManifestFromBags({"x.bag"}, "", {"a", "b"}, &m).ok());
+  EXPECT_FALSE(ManifestFromBags({"x.bag", "y.bag"}, "", {"a", "a"}, &m).ok());
+}
+
+}  // namespace
+}  // namespace swarmlio::replay
