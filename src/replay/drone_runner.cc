@@ -22,6 +22,8 @@ ScanRecord ToScanRecord(const lio::ScanOutput& o) {
   r.stamp_ns = o.stamp_ns;
   r.state = o.state;
   r.pose_covariance = o.covariance.topLeftCorner<6, 6>();
+  r.velocity_covariance = o.covariance.block<3, 3>(ErrorStateLayout::kVelocity.offset,
+                                                   ErrorStateLayout::kVelocity.offset);
   r.updated = o.updated;
   r.num_raw_points = o.num_raw_points;
   r.num_points = o.num_points;

@@ -1,5 +1,7 @@
 #include "swarmlio/replay/manifest.h"
 
+#include <Eigen/Geometry>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -22,6 +24,8 @@ struct DroneEntry {
   ImuOptions imu;
   io::BagReaderOptions bag_topics;
   lio::OdometryOptions odometry;
+  Eigen::Vector3d p_G_in_W_m = Eigen::Vector3d::Zero();
+  std::vector<double> q_W_G_xyzw = {0.0, 0.0, 0.0, 1.0};
 
   template <class V>
   void VisitFields(V&& v) {
@@ -35,6 +39,10 @@ struct DroneEntry {
     v("imu", imu);
     v("bag_topics", bag_topics);
     v("odometry", odometry);
+    v("p_G_in_W_m", p_G_in_W_m,
+      FieldSpec::InRange(-1e7, 1e7, "m", "origin of G in a common world frame (plots only)"));
+    v("q_W_G_xyzw", q_W_G_xyzw,
+      FieldSpec::InRange(-1.0, 1.0, "", "rotation G -> W as a unit quaternion x y z w (plots only)"));
   }
   std::string Validate() const {
     // Sensors and odometry are validated once merged over the preset.
@@ -46,6 +54,10 @@ struct DroneEntry {
     if (!invalid.empty()) return invalid;
     if (name.empty()) return "name: must not be empty";
     if (bag.empty()) return "bag: must be given";
+    if (q_W_G_xyzw.size() != 4) return "q_W_G_xyzw: needs 4 values (x y z w)";
+    const double norm = std::sqrt(q_W_G_xyzw[0] * q_W_G_xyzw[0] + q_W_G_xyzw[1] * q_W_G_xyzw[1] +
+                                  q_W_G_xyzw[2] * q_W_G_xyzw[2] + q_W_G_xyzw[3] * q_W_G_xyzw[3]);
+    if (std::abs(norm - 1.0) > 1e-6) return "q_W_G_xyzw: must be a unit quaternion";
     return "";
   }
 };
@@ -102,6 +114,10 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     d.bag_path = Resolve(folder, e.bag);
     d.ground_truth_path = Resolve(folder, e.ground_truth);
     d.bag = e.bag_topics;
+    d.p_G_in_W_m = e.p_G_in_W_m;
+    d.R_W_G = Eigen::Quaterniond(e.q_W_G_xyzw[3], e.q_W_G_xyzw[0], e.q_W_G_xyzw[1], e.q_W_G_xyzw[2])
+                  .normalized()
+                  .toRotationMatrix();
     if (!e.sensor_preset.empty()) {
       const Status status =
           config::LoadSensorPreset(Resolve(folder, e.sensor_preset), &d.lidar, &d.imu);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <variant>
 
 #include "swarmlio/io/bag_info.h"
 
@@ -41,7 +42,50 @@ Status SwarmReplay::Create(const SwarmManifest& manifest, std::unique_ptr<SwarmR
   return Status::Ok();
 }
 
+net::LinkStats SwarmReplay::LinkStats(int from, int to) const {
+  return network_ ? network_->Stats(from, to) : net::LinkStats();
+}
+
+Status SwarmReplay::SetUpNetwork(const ReplayOptions& options) {
+  traffic_.assign(runners_.size(), DroneTraffic());
+  channels_.clear();
+  network_.reset();
+  if (options.single_agent) return Status::Ok();
+  std::vector<int> ids;
+  for (size_t i = 0; i < runners_.size(); ++i) ids.push_back(static_cast<int>(i));
+  SWARMLIO_RETURN_IF_ERROR(net::SimulatedNetwork::Create(options.network, ids, &network_));
+  SWARMLIO_RETURN_IF_ERROR(net::PacketCodec::Create(
+      net::SwarmKey::ForSimulation(static_cast<uint64_t>(options.network.seed)), &codec_));
+  for (int id : ids) {
+    channels_.push_back(std::make_unique<net::MessageChannel>(&codec_, network_->Endpoint(id)));
+  }
+  return Status::Ok();
+}
+
+Status SwarmReplay::Broadcast(int drone, size_t first_new_scan) {
+  const std::vector<ScanRecord>& scans = runners_[drone]->scans();
+  for (size_t k = first_new_scan; k < scans.size(); ++k) {
+    const ScanRecord& r = scans[k];
+    net::EgoStateMessage m;
+    m.sender_id = drone;
+    m.stamp_ns = r.stamp_ns;
+    m.session_start_ns = runners_[drone]->odometry().initialization().stamp_ns;
+    m.q_Gj_bj = r.state.q_G_b.normalized();
+    m.p_bj_in_Gj = r.state.p_b_in_G;
+    m.v_bj_in_Gj = r.state.v_b_in_G;
+    m.cov_theta_Gj_bj = r.pose_covariance.topLeftCorner<3, 3>();
+    m.cov_p_bj_in_Gj = r.pose_covariance.bottomRightCorner<3, 3>();
+    m.cov_v_bj_in_Gj = r.velocity_covariance;
+    m.degenerated = r.degenerate;
+    SWARMLIO_RETURN_IF_ERROR(channels_[drone]->Send(r.stamp_ns, net::kBroadcastId, m));
+    ++traffic_[drone].sent;
+  }
+  return Status::Ok();
+}
+
 Status SwarmReplay::Run(const ReplayOptions& options) {
+  SWARMLIO_RETURN_IF_ERROR(SetUpNetwork(options));
+  std::vector<net::ReceivedMessage> inbox;
   Status first_error;
   ReplayProgress progress;
   progress.start_stamp_ns = start_stamp_ns_;
@@ -61,10 +105,25 @@ Status SwarmReplay::Run(const ReplayOptions& options) {
     }
     if (best < 0 || runners_[best]->next_stamp_ns() > limit_ns) break;
     progress.stamp_ns = runners_[best]->next_stamp_ns();
+    if (!channels_.empty()) {
+      // What reached this drone by the stamp of its next record.
+      inbox.clear();
+      const Status polled = channels_[best]->Poll(progress.stamp_ns, &inbox);
+      if (!polled.ok() && first_error.ok()) first_error = polled;
+      for (const net::ReceivedMessage& m : inbox) {
+        ++traffic_[best].received;
+        if (std::holds_alternative<net::EgoStateMessage>(m.message)) ++traffic_[best].ego_states;
+      }
+    }
+    const size_t scans_before = runners_[best]->scans().size();
     const Status status = runners_[best]->Step();
     if (!status.ok()) {
       failed[best] = true;
       if (first_error.ok()) first_error = status;
+    }
+    if (!channels_.empty() && runners_[best]->scans().size() > scans_before) {
+      const Status sent = Broadcast(best, scans_before);
+      if (!sent.ok() && first_error.ok()) first_error = sent;
     }
     ++progress.records;
     if (options.on_progress && progress.records % options.progress_every_records == 0) {
@@ -75,6 +134,7 @@ Status SwarmReplay::Run(const ReplayOptions& options) {
     const Status status = runner->Finish();
     if (!status.ok() && first_error.ok()) first_error = status;
   }
+  for (size_t i = 0; i < channels_.size(); ++i) traffic_[i].channel = channels_[i]->stats();
   if (options.on_progress) {
     progress.stamp_ns = progress.end_stamp_ns;
     options.on_progress(progress);

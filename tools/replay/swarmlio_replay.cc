@@ -1,10 +1,12 @@
 // swarmlio_replay: runs the estimators of N drones on their recorded bags in
-// one process (N = 1: single-drone LiDAR-inertial odometry) and writes, per
-// drone, into --output_dir:
+// one process (N = 1: single-drone LiDAR-inertial odometry), inter-drone
+// messages through a seeded simulated network, and writes into --output_dir:
 //   <name>_tum.txt     estimated trajectory (TUM: t x y z qx qy qz qw, body in G)
 //   <name>_map.pcd     the final local map (G frame)
-//   <name>_timing.csv  per-scan counts and stage times (docs/replay.md)
-// and prints a summary (per-scan time statistics, real-time factor, peak RSS).
+//   <name>_timing.csv  per-scan counts and stage times
+//   metrics.{md,csv,json}  per-drone APE/RPE, time statistics, real-time factor, NEES
+//   top_view.png, ape_over_time.png, network.csv
+// and prints a summary and the metrics table (docs/replay.md).
 //
 //   swarmlio_replay --manifest=sim_out/swarm.yaml --output_dir=results/run1
 //   swarmlio_replay --bags=a.bag --sensor_preset=configs/livox_avia.yaml --output_dir=out
@@ -22,7 +24,8 @@
 #include <vector>
 
 #include "progress_bar.h"
-#include "swarmlio/io/pcd_writer.h"
+#include "report.h"
+#include "swarmlio/config/config_file.h"
 #include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
@@ -34,6 +37,11 @@ DEFINE_string(sensor_preset, "", "sensor preset (configs/*.yaml) for every bag o
 DEFINE_string(output_dir, "", "results folder (created)");
 DEFINE_double(max_duration_s, 0.0, "replay only this much log time [s]; 0 = all");
 DEFINE_bool(save_maps, true, "write <name>_map.pcd per drone");
+DEFINE_bool(single_agent, false,
+            "ablation: every drone runs alone (no messages), as single-agent odometry");
+DEFINE_string(network_config, "",
+              "YAML file with a `network:` section (latency, jitter, loss, reordering, "
+              "duplication, seed; docs/network.md); default: the NetworkOptions defaults");
 
 namespace swarmlio::tools {
 namespace {
@@ -47,49 +55,10 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
-double Percentile(std::vector<double> v, double p) {
+double Median(std::vector<double> v, double p = 0.5) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
-  const double pos = p * static_cast<double>(v.size() - 1);
-  const size_t lo = static_cast<size_t>(pos);
-  const size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
-Status WriteTum(const std::string& path, const std::vector<replay::ScanRecord>& scans) {
-  std::ofstream out(path);
-  if (!out) return Status::IoError(path + ": cannot open for writing");
-  out << "# timestamp tx ty tz qx qy qz qw (body/IMU frame in the drone's global frame G)\n";
-  out << std::fixed;
-  for (const replay::ScanRecord& s : scans) {
-    const Eigen::Quaterniond& q = s.state.q_G_b;
-    const Eigen::Vector3d& p = s.state.p_b_in_G;
-    out << std::setprecision(9) << StampSeconds(s.stamp_ns) << std::setprecision(9) << " "
-        << p.x() << " " << p.y() << " " << p.z() << " " << q.x() << " " << q.y() << " " << q.z()
-        << " " << q.w() << "\n";
-  }
-  return out ? Status::Ok() : Status::IoError(path + ": write failed");
-}
-
-Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord>& scans) {
-  std::ofstream out(path);
-  if (!out) return Status::IoError(path + ": cannot open for writing");
-  out << "stamp_s,updated,raw_points,points,correspondences,iterations,min_normal_information,"
-         "degenerate,map_points,"
-         "preprocess_ms,propagate_ms,undistort_ms,association_ms,solve_ms,covariance_ms,"
-         "map_update_ms,total_ms\n";
-  out << std::fixed;
-  for (const replay::ScanRecord& s : scans) {
-    const lio::ScanTimings& t = s.timings;
-    out << std::setprecision(9) << StampSeconds(s.stamp_ns) << "," << (s.updated ? 1 : 0) << ","
-        << s.num_raw_points << "," << s.num_points << "," << s.num_correspondences << ","
-        << s.iterations << "," << std::setprecision(2) << s.min_normal_information << ","
-        << (s.degenerate ? 1 : 0) << "," << s.map_size << std::setprecision(4) << ","
-        << 1e3 * t.preprocess_s << "," << 1e3 * t.propagate_s << "," << 1e3 * t.undistort_s << ","
-        << 1e3 * t.association_s << "," << 1e3 * t.solve_s << "," << 1e3 * t.covariance_s << ","
-        << 1e3 * t.map_update_s << "," << 1e3 * t.total_s << "\n";
-  }
-  return out ? Status::Ok() : Status::IoError(path + ": write failed");
+  return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
 }
 
 struct StageStats {
@@ -118,8 +87,8 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     std::printf("  IMU init: %s\n", d.odometry().initialization().Summary().c_str());
   }
   if (!total.empty()) {
-    std::printf("  per-scan time [ms]: median %.2f  p95 %.2f  max %.2f", Percentile(total, 0.5),
-                Percentile(total, 0.95), Percentile(total, 1.0));
+    std::printf("  per-scan time [ms]: median %.2f  p95 %.2f  max %.2f", Median(total),
+                Median(total, 0.95), Median(total, 1.0));
     const StageStats stages[] = {{"preprocess", &lio::ScanTimings::preprocess_s},
                                  {"propagate", &lio::ScanTimings::propagate_s},
                                  {"undistort", &lio::ScanTimings::undistort_s},
@@ -133,7 +102,7 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
       for (const auto& s : scans) {
         if (s.updated) v.push_back(1e3 * (s.timings.*st.field));
       }
-      std::printf(" %s %.2f", st.name, Percentile(v, 0.5));
+      std::printf(" %s %.2f", st.name, Median(v));
     }
     std::printf("\n");
   }
@@ -198,6 +167,17 @@ int Main() {
   ProgressBar bar("replay " + manifest.name);
   replay::ReplayOptions options;
   options.max_duration_s = FLAGS_max_duration_s;
+  options.single_agent = FLAGS_single_agent;
+  if (!FLAGS_network_config.empty()) {
+    config::ConfigFile file;
+    status = config::ConfigFile::Load(FLAGS_network_config, &file);
+    if (status.ok()) status = file.Read("network", &options.network);
+    if (status.ok()) status = file.CheckNoUnusedSections();
+    if (!status.ok()) {
+      std::fprintf(stderr, "error: %s\n", status.message().c_str());
+      return 1;
+    }
+  }
   options.on_progress = [&](const replay::ReplayProgress& p) {
     std::ostringstream detail;
     detail << std::fixed << std::setprecision(1)
@@ -211,24 +191,26 @@ int Main() {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // Results are written even after an error: partial results are kept.
-  int exit_code = run_status.ok() ? 0 : 1;
-  const std::filesystem::path dir(FLAGS_output_dir);
-  for (int i = 0; i < run->num_drones(); ++i) {
-    const replay::DroneRunner& d = run->drone(i);
-    const std::string& name = d.input().name;
-    std::vector<Status> writes = {WriteTum((dir / (name + "_tum.txt")).string(), d.scans()),
-                                  WriteTiming((dir / (name + "_timing.csv")).string(), d.scans())};
-    if (FLAGS_save_maps) {
-      writes.push_back(io::WritePcd((dir / (name + "_map.pcd")).string(), d.odometry().MapPoints()));
+  for (int i = 0; i < run->num_drones(); ++i) PrintSummary(run->drone(i), wall_s);
+  if (!FLAGS_single_agent) {
+    for (int i = 0; i < run->num_drones(); ++i) {
+      const replay::DroneTraffic& t = run->traffic(i);
+      std::printf("%s: sent %lld messages, received %lld (rejected %llu, duplicates %llu)\n",
+                  run->drone(i).input().name.c_str(), static_cast<long long>(t.sent),
+                  static_cast<long long>(t.received),
+                  static_cast<unsigned long long>(t.channel.rejected),
+                  static_cast<unsigned long long>(t.channel.duplicates));
     }
-    for (const Status& w : writes) {
-      if (!w.ok()) {
-        std::fprintf(stderr, "error: %s\n", w.message().c_str());
-        exit_code = 1;
-      }
-    }
-    PrintSummary(d, wall_s);
   }
+  ReportOptions report;
+  report.output_dir = FLAGS_output_dir;
+  report.single_agent = FLAGS_single_agent;
+  report.save_maps = FLAGS_save_maps;
+  std::string markdown, problems;
+  const Status report_status = WriteReport(*run, report, &markdown, &problems);
+  std::printf("\n%s%s\n", FLAGS_single_agent ? "single-agent ablation\n" : "", markdown.c_str());
+  int exit_code = run_status.ok() && report_status.ok() ? 0 : 1;
+  if (!problems.empty()) std::fprintf(stderr, "errors:\n%s", problems.c_str());
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   std::printf("peak RSS %.1f MiB, wall %.1f s; results in %s\n",

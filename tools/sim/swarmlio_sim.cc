@@ -70,16 +70,22 @@ std::string Resolved(const Scenario& s, const Simulator& sim) {
 
 // The replay manifest (docs/replay.md) of the simulated logs: bags, ground
 // truth, the sensors as simulated and the IMU time offset as if calibrated.
-std::string Manifest(const Scenario& s) {
+std::string Manifest(const Scenario& s, const Simulator& sim) {
   std::ostringstream os;
   os << std::setprecision(17);
   os << "# Replay manifest of the simulated run (written by swarmlio_sim).\n";
   os << "# swarmlio_replay --manifest=<this file> --output_dir=...\n";
   os << "name: " << s.options.name << "\n";
   os << "drones:\n";
-  for (const DroneConfig& d : s.drones) {
+  for (size_t i = 0; i < s.drones.size(); ++i) {
+    const DroneConfig& d = s.drones[i];
+    const Pose T = sim.T_W_G(static_cast<int>(i));
+    const Eigen::Quaterniond q(T.R_W_b);
     os << "  - name: " << d.name << "\n";
     os << "    bag: " << d.name << ".bag\n";
+    os << "    # G_i in the simulation world W (for plots)\n";
+    os << "    p_G_in_W_m: " << Vec(T.p_b_in_W) << "\n";
+    os << "    q_W_G_xyzw: [" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w() << "]\n";
     os << "    ground_truth: " << d.name << "_gt_tum.txt\n";
     os << Indented(config::DumpOptions(d.lidar.sensor, "lidar"), "    ");
     os << Indented(config::DumpOptions(d.imu.sensor, "imu"), "    ");
@@ -136,7 +142,7 @@ int Main() {
       return 1;
     }
     std::ofstream manifest(dir / "swarm.yaml");
-    manifest << Manifest(scenario);
+    manifest << Manifest(scenario, sim);
     if (!manifest) {
       std::fprintf(stderr, "error: cannot write swarm.yaml\n");
       return 1;

@@ -25,6 +25,7 @@ struct ScanRecord {
   EgoState state;
   /// Covariance of [dtheta, dp] (rotation, position), ErrorStateLayout order.
   Eigen::Matrix<double, 6, 6> pose_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();
   bool updated = false;
   int num_raw_points = 0;
   int num_points = 0;

@@ -11,12 +11,15 @@
 //       lidar: {p_lidar_in_imu_m: [0, 0, 0.08]}        # optional overrides
 //       bag_topics: {imu_topic: /mavros/imu/data}
 //       odometry: {imu_time_offset_s: 0.002}
+//       p_G_in_W_m: [0, 0, 0]           # optional, for plots: G in a common frame W
+//       q_W_G_xyzw: [0, 0, 0, 1]
 //
 // Odometry defaults follow the drone's LiDAR (lio::OdometryOptionsFor), then
 // the `odometry:` keys apply over them; the IMU initializer takes the
 // acceleration unit of the `imu:` section.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -36,6 +39,10 @@ struct DroneInput {
   ImuOptions imu;
   io::BagReaderOptions bag;
   lio::OdometryOptions odometry;
+  /// Where the drone's global frame G lies in a common world frame W, only
+  /// for drawing all drones in one top view (identity when unknown).
+  Eigen::Matrix3d R_W_G = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_G_in_W_m = Eigen::Vector3d::Zero();
 };
 
 struct SwarmManifest {

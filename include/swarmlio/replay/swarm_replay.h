@@ -1,8 +1,14 @@
 // SwarmReplay: runs the estimators of N drones in one process on recorded
 // time. Records of all bags are consumed in stamp order (ties: lower drone
 // index first), so a run is a deterministic function of the logs and options.
-// Until the swarm layer exists, drones run independently (the single-agent
-// ablation); the inter-drone network plugs into this loop.
+// Inter-drone messages go through a seeded simulated network (net::
+// SimulatedNetwork behind the net::Transport interface a UDP transport will
+// implement): after every scan a drone broadcasts its EgoStateMessage, and
+// before each of its records it polls what has arrived by that record's stamp.
+// The network's clock is the recorded stamps (drone clock offsets are not
+// modelled in delivery). Until the swarm layer exists the estimators do not
+// consume the messages; they are counted per drone. single_agent (the
+// ablation) sends nothing.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +18,10 @@
 #include <vector>
 
 #include "swarmlio/common/status.h"
+#include "swarmlio/net/message_channel.h"
+#include "swarmlio/net/network_options.h"
+#include "swarmlio/net/packet_codec.h"
+#include "swarmlio/net/simulated_network.h"
 #include "swarmlio/replay/drone_runner.h"
 #include "swarmlio/replay/manifest.h"
 
@@ -31,6 +41,18 @@ struct ReplayOptions {
   /// Called every `progress_every_records` records (tool-side progress bar).
   std::function<void(const ReplayProgress&)> on_progress;
   int64_t progress_every_records = 2000;
+  /// Ablation: every drone runs alone, no message is sent.
+  bool single_agent = false;
+  /// The simulated network (latency, jitter, loss, reordering, duplication).
+  net::NetworkOptions network;
+};
+
+/// What one drone's channel received.
+struct DroneTraffic {
+  int64_t received = 0;         // messages delivered by Poll
+  int64_t ego_states = 0;       // of which EgoStateMessage
+  int64_t sent = 0;             // messages broadcast
+  net::ChannelStats channel;    // rejected, duplicates, ...
 };
 
 class SwarmReplay {
@@ -40,8 +62,12 @@ class SwarmReplay {
 
   /// Runs to the end of all logs (or max_duration_s). On a read error the
   /// other drones still run to the end; the first error is returned and the
-  /// results so far are kept.
+  /// results so far are kept. InvalidArgument for invalid network options.
   Status Run(const ReplayOptions& options);
+
+  /// Per-drone message counts and the network's link statistics (after Run).
+  const DroneTraffic& traffic(int i) const { return traffic_[i]; }
+  net::LinkStats LinkStats(int from, int to) const;
 
   int num_drones() const { return static_cast<int>(runners_.size()); }
   const DroneRunner& drone(int i) const { return *runners_[i]; }
@@ -52,6 +78,13 @@ class SwarmReplay {
 
   SwarmManifest manifest_;
   std::vector<std::unique_ptr<DroneRunner>> runners_;
+  Status SetUpNetwork(const ReplayOptions& options);
+  Status Broadcast(int drone, size_t first_new_scan);
+
+  std::unique_ptr<net::SimulatedNetwork> network_;
+  net::PacketCodec codec_;
+  std::vector<std::unique_ptr<net::MessageChannel>> channels_;
+  std::vector<DroneTraffic> traffic_;
   int64_t start_stamp_ns_ = 0;
   int64_t end_stamp_ns_ = 0;
 };

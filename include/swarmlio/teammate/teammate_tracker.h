@@ -1,0 +1,91 @@
+// A teammate tracker (paper Sec. III-D-1): an identified teammate j, tracked
+// in G_i with the constant-velocity filter, but
+//  - predicted with the velocity j broadcasts, rotated by R_Gi_Gj;
+//  - updated from a LiDAR cluster when j is seen, otherwise from j's
+//    broadcast position mapped through the global extrinsic T_Gi_Gj.
+// Swarm-LIO2 trusts the broadcast odometry more than the cluster for this
+// filter (0.001 vs 0.01 m^2); the filter only predicts where to look, the
+// observation output is the cluster itself (observation.h).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "swarmlio/config/option_fields.h"
+#include "swarmlio/teammate/cv_filter.h"
+#include "swarmlio/teammate/odometry_history.h"
+
+namespace swarmlio::teammate {
+
+/// YAML section `teammate.teammate`.
+struct TeammateTrackerOptions {
+  double lidar_position_sigma_m = 0.1;      // cluster measurement 1-sigma (0.01 m^2)
+  double odometry_position_sigma_m = 0.03;  // broadcast position 1-sigma (0.001 m^2)
+  double velocity_sigma_m_s = 0.1;          // 1-sigma of the broadcast velocity in prediction
+  double max_odometry_age_s = 0.5;          // older broadcasts are not used to update
+  double disconnect_s = 2.0;                // no message for this long: the tracker holds still
+
+  template <class V>
+  void VisitFields(V&& v) {
+    using config::FieldSpec;
+    v("lidar_position_sigma_m", lidar_position_sigma_m,
+      FieldSpec::Positive("m", "1-sigma of a cluster position in the teammate filter"));
+    v("odometry_position_sigma_m", odometry_position_sigma_m,
+      FieldSpec::Positive("m", "1-sigma of the broadcast position through T_Gi_Gj"));
+    v("velocity_sigma_m_s", velocity_sigma_m_s,
+      FieldSpec::Positive("m/s", "1-sigma of the broadcast velocity used to predict"));
+    v("max_odometry_age_s", max_odometry_age_s,
+      FieldSpec::Positive("s", "broadcast older than this is stale (not used to update)"));
+    v("disconnect_s", disconnect_s,
+      FieldSpec::Positive("s", "no broadcast for this long: prediction stops"));
+  }
+  std::string Validate() const { return config::ValidateFields(*this); }
+};
+
+class TeammateTracker {
+ public:
+  /// Takes over a temporary tracker's filter after identification.
+  TeammateTracker(int drone_id, int tracker_id, const Eigen::Matrix3d& R_Gi_Gj,
+                  const Eigen::Vector3d& p_Gj_in_Gi, const ConstantVelocityFilter& filter);
+
+  int drone_id() const { return drone_id_; }
+  int tracker_id() const { return tracker_id_; }
+  const Eigen::Matrix3d& R_Gi_Gj() const { return R_Gi_Gj_; }
+  const Eigen::Vector3d& p_Gj_in_Gi() const { return p_Gj_in_Gi_; }
+  void SetGlobalExtrinsic(const Eigen::Matrix3d& R_Gi_Gj, const Eigen::Vector3d& p_Gj_in_Gi) {
+    R_Gi_Gj_ = R_Gi_Gj;
+    p_Gj_in_Gi_ = p_Gj_in_Gi;
+  }
+
+  /// The teammate's velocity in G_i at `stamp_s` from its broadcasts (the
+  /// newest one while connected); false when disconnected.
+  bool VelocityInGi(double stamp_s, const OdometryHistory& history,
+                    const TeammateTrackerOptions& options, Eigen::Vector3d* v_in_Gi) const;
+
+  /// Moves the filter to `stamp_s` with the broadcast velocity.
+  void Predict(double stamp_s, const OdometryHistory& history, const TeammateTrackerOptions& options);
+  /// Predicted position at `stamp_s` (state unchanged).
+  Eigen::Vector3d PositionAt(double stamp_s, const OdometryHistory& history,
+                             const TeammateTrackerOptions& options) const;
+
+  /// LiDAR update with a cluster position measured at `stamp_s`.
+  void UpdateLidar(double stamp_s, const Eigen::Vector3d& p_in_Gi, const OdometryHistory& history,
+                   const TeammateTrackerOptions& options);
+  /// Update with the broadcast position at `stamp_s` mapped into G_i; false
+  /// (no update, prediction only) when the broadcast is stale.
+  bool UpdateOdometry(double stamp_s, const OdometryHistory& history,
+                      const TeammateTrackerOptions& options);
+
+  const ConstantVelocityFilter& filter() const { return filter_; }
+  double last_lidar_update_s() const { return last_lidar_update_s_; }
+
+ private:
+  int drone_id_;
+  int tracker_id_;
+  Eigen::Matrix3d R_Gi_Gj_;
+  Eigen::Vector3d p_Gj_in_Gi_;
+  ConstantVelocityFilter filter_;
+  double last_lidar_update_s_ = -1e300;
+};
+
+}  // namespace swarmlio::teammate

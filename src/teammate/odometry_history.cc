@@ -1,0 +1,60 @@
+#include "swarmlio/teammate/odometry_history.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace swarmlio::teammate {
+
+void OdometryHistory::Add(const TeammateOdometry& odometry, double keep_s) {
+  auto it = std::lower_bound(
+      messages_.begin(), messages_.end(), odometry.stamp_s,
+      [](const TeammateOdometry& m, double stamp_s) { return m.stamp_s < stamp_s; });
+  if (it != messages_.end() && it->stamp_s == odometry.stamp_s) {
+    *it = odometry;
+  } else {
+    messages_.insert(it, odometry);
+  }
+  const double oldest_kept = messages_.back().stamp_s - keep_s;
+  while (!messages_.empty() && messages_.front().stamp_s < oldest_kept) messages_.pop_front();
+}
+
+bool OdometryHistory::StateAt(double stamp_s, double max_gap_s, double max_extrapolation_s,
+                              Eigen::Vector3d* p_bj_in_Gj, Eigen::Vector3d* v_bj_in_Gj) const {
+  if (messages_.empty()) return false;
+  auto after = std::lower_bound(
+      messages_.begin(), messages_.end(), stamp_s,
+      [](const TeammateOdometry& m, double s) { return m.stamp_s < s; });
+  if (after != messages_.end() && after != messages_.begin()) {
+    const TeammateOdometry& a = *(after - 1);
+    const TeammateOdometry& b = *after;
+    const double h = b.stamp_s - a.stamp_s;
+    if (h <= max_gap_s && h > 0.0) {
+      // Cubic Hermite on [a, b] with the broadcast velocities as tangents.
+      const double s = (stamp_s - a.stamp_s) / h;
+      const double s2 = s * s, s3 = s2 * s;
+      const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s;
+      const double h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+      *p_bj_in_Gj = h00 * a.p_bj_in_Gj + h10 * h * a.v_bj_in_Gj + h01 * b.p_bj_in_Gj +
+                    h11 * h * b.v_bj_in_Gj;
+      if (v_bj_in_Gj != nullptr) *v_bj_in_Gj = (1.0 - s) * a.v_bj_in_Gj + s * b.v_bj_in_Gj;
+      return true;
+    }
+  }
+  // Nearest message, extrapolated with its velocity.
+  const TeammateOdometry* nearest = nullptr;
+  if (after != messages_.end()) nearest = &*after;
+  if (after != messages_.begin()) {
+    const TeammateOdometry& before = *(after - 1);
+    if (nearest == nullptr ||
+        std::abs(before.stamp_s - stamp_s) < std::abs(nearest->stamp_s - stamp_s)) {
+      nearest = &before;
+    }
+  }
+  const double dt = stamp_s - nearest->stamp_s;
+  if (std::abs(dt) > max_extrapolation_s) return false;
+  *p_bj_in_Gj = nearest->p_bj_in_Gj + nearest->v_bj_in_Gj * dt;
+  if (v_bj_in_Gj != nullptr) *v_bj_in_Gj = nearest->v_bj_in_Gj;
+  return true;
+}
+
+}  // namespace swarmlio::teammate

@@ -1,0 +1,65 @@
+#include "swarmlio/teammate/teammate_tracker.h"
+
+#include <cmath>
+
+namespace swarmlio::teammate {
+
+TeammateTracker::TeammateTracker(int drone_id, int tracker_id, const Eigen::Matrix3d& R_Gi_Gj,
+                                 const Eigen::Vector3d& p_Gj_in_Gi,
+                                 const ConstantVelocityFilter& filter)
+    : drone_id_(drone_id),
+      tracker_id_(tracker_id),
+      R_Gi_Gj_(R_Gi_Gj),
+      p_Gj_in_Gi_(p_Gj_in_Gi),
+      filter_(filter) {}
+
+bool TeammateTracker::VelocityInGi(double stamp_s, const OdometryHistory& history,
+                                   const TeammateTrackerOptions& options,
+                                   Eigen::Vector3d* v_in_Gi) const {
+  if (history.empty() || stamp_s - history.newest().stamp_s > options.disconnect_s) return false;
+  Eigen::Vector3d p_bj_in_Gj, v_bj_in_Gj;
+  if (!history.StateAt(stamp_s, options.max_odometry_age_s, options.max_odometry_age_s,
+                       &p_bj_in_Gj, &v_bj_in_Gj)) {
+    v_bj_in_Gj = history.newest().v_bj_in_Gj;
+  }
+  *v_in_Gi = R_Gi_Gj_ * v_bj_in_Gj;
+  return true;
+}
+
+void TeammateTracker::Predict(double stamp_s, const OdometryHistory& history,
+                              const TeammateTrackerOptions& options) {
+  Eigen::Vector3d v_in_Gi;
+  if (!VelocityInGi(stamp_s, history, options, &v_in_Gi)) v_in_Gi.setZero();
+  filter_.PredictWithVelocity(stamp_s, v_in_Gi, options.velocity_sigma_m_s);
+}
+
+Eigen::Vector3d TeammateTracker::PositionAt(double stamp_s, const OdometryHistory& history,
+                                            const TeammateTrackerOptions& options) const {
+  Eigen::Vector3d v_in_Gi;
+  if (!VelocityInGi(stamp_s, history, options, &v_in_Gi)) return filter_.p();
+  return filter_.p() + v_in_Gi * (stamp_s - filter_.stamp_s());
+}
+
+void TeammateTracker::UpdateLidar(double stamp_s, const Eigen::Vector3d& p_in_Gi,
+                                  const OdometryHistory& history,
+                                  const TeammateTrackerOptions& options) {
+  Predict(stamp_s, history, options);
+  const double sigma = options.lidar_position_sigma_m;
+  filter_.Update(p_in_Gi, sigma * sigma * Eigen::Matrix3d::Identity());
+  last_lidar_update_s_ = stamp_s;
+}
+
+bool TeammateTracker::UpdateOdometry(double stamp_s, const OdometryHistory& history,
+                                     const TeammateTrackerOptions& options) {
+  Predict(stamp_s, history, options);
+  Eigen::Vector3d p_bj_in_Gj;
+  if (!history.StateAt(stamp_s, options.max_odometry_age_s, options.max_odometry_age_s,
+                       &p_bj_in_Gj, nullptr)) {
+    return false;
+  }
+  const double sigma = options.odometry_position_sigma_m;
+  filter_.Update(R_Gi_Gj_ * p_bj_in_Gj + p_Gj_in_Gi_, sigma * sigma * Eigen::Matrix3d::Identity());
+  return true;
+}
+
+}  // namespace swarmlio::teammate

@@ -1,0 +1,22 @@
+#include "swarmlio/teammate/temporary_tracker.h"
+
+namespace swarmlio::teammate {
+
+TemporaryTracker::TemporaryTracker(int id, double stamp_s, const Eigen::Vector3d& p_in_G,
+                                   const TemporaryTrackerOptions& options, int trajectory_capacity)
+    : id_(id), created_s_(stamp_s), last_update_s_(stamp_s), trajectory_(trajectory_capacity) {
+  filter_.Initialize(stamp_s, p_in_G, Eigen::Vector3d::Zero(), options.filter.lidar_position_sigma_m,
+                     options.filter.initial_velocity_sigma_m_s);
+  trajectory_.Push(stamp_s, p_in_G);
+}
+
+void TemporaryTracker::Update(double stamp_s, const Eigen::Vector3d& p_in_G,
+                              const TemporaryTrackerOptions& options) {
+  filter_.PredictTo(stamp_s, options.filter.accel_noise_density_m_s2_sqrt_hz);
+  const double sigma = options.filter.lidar_position_sigma_m;
+  filter_.Update(p_in_G, sigma * sigma * Eigen::Matrix3d::Identity());
+  last_update_s_ = stamp_s;
+  trajectory_.Push(stamp_s, filter_.p());
+}
+
+}  // namespace swarmlio::teammate

@@ -1,0 +1,207 @@
+#include "report.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <vector>
+
+#include "swarmlio/eval/drone_metrics.h"
+#include "swarmlio/eval/plots.h"
+#include "swarmlio/eval/trajectory_io.h"
+#include "swarmlio/io/pcd_writer.h"
+#include "swarmlio/replay/consistency.h"
+
+namespace swarmlio::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = p * static_cast<double>(v.size() - 1);
+  const size_t lo = static_cast<size_t>(pos);
+  const size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+eval::Trajectory EstimateTrajectory(const std::vector<replay::ScanRecord>& scans) {
+  eval::Trajectory t;
+  for (const replay::ScanRecord& s : scans) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = s.state.q_G_b.normalized().toRotationMatrix();
+    T.translation() = s.state.p_b_in_G;
+    t.stamps_s.push_back(StampSeconds(s.stamp_ns));
+    t.T_G_b.push_back(T);
+  }
+  return t;
+}
+
+std::vector<PoseStamped> ToPoses(const eval::Trajectory& t) {
+  std::vector<PoseStamped> out;
+  for (size_t i = 0; i < t.size(); ++i) {
+    PoseStamped p;
+    p.stamp_ns = static_cast<int64_t>(std::llround(t.stamps_s[i] * 1e9));
+    p.q_G_b = Eigen::Quaterniond(t.T_G_b[i].linear());
+    p.p_b_in_G = t.T_G_b[i].translation();
+    out.push_back(p);
+  }
+  return out;
+}
+
+Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord>& scans) {
+  std::ofstream out(path);
+  if (!out) return Status::IoError(path + ": cannot open for writing");
+  out << "stamp_s,updated,raw_points,points,correspondences,iterations,min_normal_information,"
+         "degenerate,map_points,preprocess_ms,propagate_ms,undistort_ms,association_ms,solve_ms,"
+         "covariance_ms,map_update_ms,total_ms\n";
+  out << std::fixed;
+  for (const replay::ScanRecord& s : scans) {
+    const lio::ScanTimings& t = s.timings;
+    out << std::setprecision(9) << StampSeconds(s.stamp_ns) << "," << (s.updated ? 1 : 0) << ","
+        << s.num_raw_points << "," << s.num_points << "," << s.num_correspondences << ","
+        << s.iterations << "," << std::setprecision(2) << s.min_normal_information << ","
+        << (s.degenerate ? 1 : 0) << "," << s.map_size << std::setprecision(4) << ","
+        << 1e3 * t.preprocess_s << "," << 1e3 * t.propagate_s << "," << 1e3 * t.undistort_s << ","
+        << 1e3 * t.association_s << "," << 1e3 * t.solve_s << "," << 1e3 * t.covariance_s << ","
+        << 1e3 * t.map_update_s << "," << 1e3 * t.total_s << "\n";
+  }
+  return out ? Status::Ok() : Status::IoError(path + ": write failed");
+}
+
+Status WriteNetwork(const std::string& path, const replay::SwarmReplay& run) {
+  std::ofstream out(path);
+  if (!out) return Status::IoError(path + ": cannot open for writing");
+  out << "from,to,sent,delivered,dropped_loss,dropped_queue,duplicated,reordered,bytes_sent,"
+         "mean_latency_ms\n";
+  for (int i = 0; i < run.num_drones(); ++i) {
+    for (int j = 0; j < run.num_drones(); ++j) {
+      if (i == j) continue;
+      const net::LinkStats s = run.LinkStats(i, j);
+      out << run.drone(i).input().name << "," << run.drone(j).input().name << "," << s.sent << ","
+          << s.delivered << "," << s.dropped_loss << "," << s.dropped_queue << ","
+          << s.duplicated << "," << s.reordered << "," << s.bytes_sent << ","
+          << (s.delivered > 0 ? 1e3 * s.latency_sum_s / static_cast<double>(s.delivered) : 0.0)
+          << "\n";
+    }
+  }
+  return out ? Status::Ok() : Status::IoError(path + ": write failed");
+}
+
+// Moves plotted positions from a drone's G into the common frame W.
+Eigen::Matrix3Xd ToWorld(const replay::DroneInput& d, const Eigen::Matrix3Xd& p_in_G) {
+  Eigen::Matrix3Xd out = d.R_W_G * p_in_G;
+  out.colwise() += d.p_G_in_W_m;
+  return out;
+}
+
+}  // namespace
+
+Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
+                   std::string* markdown, std::string* problems) {
+  const fs::path dir(options.output_dir);
+  Status first_error;
+  problems->clear();
+  auto note = [&](const Status& s) {
+    if (s.ok()) return;
+    if (first_error.ok()) first_error = s;
+    *problems += s.message() + "\n";
+  };
+
+  eval::DroneMetricsOptions metric_options;
+  std::vector<eval::DroneMetrics> metrics;
+  std::vector<eval::TopViewSeries> top_view;
+  std::vector<eval::ErrorSeries> errors;
+  for (int i = 0; i < run.num_drones(); ++i) {
+    const replay::DroneRunner& d = run.drone(i);
+    const std::string& name = d.input().name;
+    const eval::Trajectory estimate = EstimateTrajectory(d.scans());
+    note(eval::WriteTumTrajectory((dir / (name + "_tum.txt")).string(), estimate));
+    note(WriteTiming((dir / (name + "_timing.csv")).string(), d.scans()));
+    if (options.save_maps) {
+      note(io::WritePcd((dir / (name + "_map.pcd")).string(), d.odometry().MapPoints()));
+    }
+
+    eval::DroneMetrics m;
+    m.drone = name;
+    std::vector<double> total_ms;
+    double busy_s = 0.0;
+    for (const auto& s : d.scans()) {
+      busy_s += s.timings.total_s;
+      if (s.updated) total_ms.push_back(1e3 * s.timings.total_s);
+    }
+    const double log_s = d.scans().size() < 2 ? 0.0
+                                              : StampSeconds(d.scans().back().stamp_ns -
+                                                             d.scans().front().stamp_ns);
+    std::vector<std::pair<std::string, double>> extra = {{"scans", static_cast<double>(d.scans().size())},
+               {"time_median_ms", Percentile(total_ms, 0.5)},
+               {"time_p95_ms", Percentile(total_ms, 0.95)},
+               {"realtime_factor", busy_s > 0.0 ? log_s / busy_s : 0.0}};
+
+    // Ground truth: the manifest's TUM file, else the bag's topic.
+    eval::Trajectory reference;
+    bool has_reference = false;
+    if (!d.input().ground_truth_path.empty()) {
+      const Status read =
+          eval::ReadTumTrajectory(d.input().ground_truth_path, eval::TrajectoryReadOptions(),
+                                  &reference);
+      note(read.WithContext(name));
+      has_reference = read.ok();
+    } else if (!d.bag_ground_truth().empty()) {
+      reference = eval::TrajectoryFromPoses(d.bag_ground_truth());
+      has_reference = true;
+    }
+    if (has_reference && !estimate.empty()) {
+      eval::ApeResult ape;
+      const Status evaluated =
+          eval::EvaluateDrone(name, reference, estimate, metric_options, &m, &ape);
+      note(evaluated.WithContext(name + ": evaluation against ground truth"));
+      if (evaluated.ok()) {
+        eval::TopViewSeries series = eval::TopViewSeriesFromApe(name, ape);
+        series.estimate_positions = ToWorld(d.input(), series.estimate_positions);
+        series.reference_positions = ToWorld(d.input(), series.reference_positions);
+        top_view.push_back(std::move(series));
+        errors.push_back(eval::ErrorSeriesFromApe(name, ape));
+        replay::ConsistencyStats consistency;
+        if (replay::EvaluateConsistency(d.scans(), ToPoses(reference), 0.05, &consistency).ok()) {
+          extra.push_back({"nees_position", consistency.mean_position_nees});
+        }
+      }
+    }
+    if (!options.single_agent) {
+      extra.push_back({"messages_received", static_cast<double>(run.traffic(i).received)});
+    }
+    m.drone = name;  // EvaluateDrone rewrites the whole struct
+    m.extra = std::move(extra);
+    metrics.push_back(std::move(m));
+  }
+
+  std::vector<eval::MetricsColumn> extra_columns = {
+      {"scans", "scans", 0},
+      {"time_median_ms", "time median [ms]", 2},
+      {"time_p95_ms", "time p95 [ms]", 2},
+      {"realtime_factor", "real-time factor", 1},
+      {"nees_position", "position NEES (3 expected)", 2}};
+  if (!options.single_agent) extra_columns.push_back({"messages_received", "msgs received", 0});
+  eval::MetricsTable table;
+  Status status = eval::MakeDroneMetricsTable(metrics, metric_options, extra_columns, &table);
+  note(status);
+  if (status.ok()) {
+    note(table.WriteAll((dir / "metrics").string()));
+    *markdown = table.ToMarkdown();
+  }
+  if (!top_view.empty()) {
+    eval::PlotOptions plot;
+    plot.title = run.manifest().name + ": estimate (SE(3)-aligned) vs ground truth";
+    note(eval::PlotTopView(top_view, plot, (dir / "top_view.png").string()));
+    plot.title = run.manifest().name + ": position error over time";
+    note(eval::PlotErrorOverTime(errors, "APE translation [m]", plot,
+                                 (dir / "ape_over_time.png").string()));
+  }
+  if (!options.single_agent) note(WriteNetwork((dir / "network.csv").string(), run));
+  return first_error;
+}
+
+}  // namespace swarmlio::tools
