@@ -74,17 +74,17 @@ case "$cmd" in
     setup
     ;;
   demo)
-    # Main job until the estimator lands: simulate the default scenario
-    # (indoor_3uav: 3 drones, 60 s), then read every drone's bag back with the
-    # streaming reader and print its contents and reader statistics.
+    # The main job on the built-in default: simulate indoor_3uav (3 drones,
+    # 60 s), replay all three logs through the estimators and the simulated
+    # network, and print the per-drone metrics table (results in $out).
     setup
     out="${DEMO_OUT:-$ROOT/results/demo}"
-    log "simulating configs/scenarios/indoor_3uav.yaml into $out"
+    log "simulating configs/scenarios/indoor_3uav.yaml into $out/sim"
     "$BUILD_DIR/tools/sim/swarmlio_sim" --scenario "$ROOT/configs/scenarios/indoor_3uav.yaml" \
+      --output_dir "$out/sim"
+    log "replaying $out/sim/swarm.yaml into $out"
+    "$BUILD_DIR/tools/replay/swarmlio_replay" --manifest "$out/sim/swarm.yaml" \
       --output_dir "$out" "${@:2}"
-    for bag in "$out"/*.bag; do
-      "$BUILD_DIR/tools/bag/swarmlio_bag_info" "$bag"
-    done
     ;;
   test)
     setup

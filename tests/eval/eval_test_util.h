@@ -14,47 +14,15 @@
 #include "swarmlio/eval/trajectory.h"
 #include "swarmlio/math/so3.h"
 
+#include "test_utils/temp_dir.h"
+
 namespace swarmlio::eval::testing {
 
 inline std::string DataFile(const std::string& name) {
   return std::string(SWARMLIO_EVAL_TEST_DATA_DIR) + "/" + name;
 }
 
-/// A fresh directory under the system temp dir, removed with its contents.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = "swarmlio_eval_";
-    if (info != nullptr) name += std::string(info->test_suite_name()) + "_" + info->name() + "_";
-    name += std::to_string(::getpid()) + "_" + std::to_string(counter++);
-    for (char& c : name) {
-      if (c == '/') c = '_';
-    }
-    path_ = std::filesystem::temp_directory_path() / name;
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  std::string File(const std::string& name) const { return (path_ / name).string(); }
-
-  /// Writes `text` to a file in the directory and returns its path.
-  std::string Write(const std::string& name, const std::string& text) const {
-    const std::string path = File(name);
-    std::ofstream(path, std::ios::binary) << text;
-    return path;
-  }
-
- private:
-  std::filesystem::path path_;
-};
+using swarmlio::testing::TempDir;
 
 inline Eigen::Isometry3d MakePose(const Eigen::Vector3d& rotation_vector,
                                   const Eigen::Vector3d& p) {
