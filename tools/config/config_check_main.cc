@@ -16,8 +16,11 @@
 
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/config/dump_options.h"
+#include "swarmlio/lio/odometry_options.h"
+#include "swarmlio/net/network_options.h"
 #include "swarmlio/sensors/imu_options.h"
 #include "swarmlio/sensors/lidar_options.h"
+#include "swarmlio/teammate/teammate_detector_options.h"
 
 DEFINE_string(config, "", "YAML config file to check (or pass it as the only argument)");
 DEFINE_bool(dump_defaults, false, "print every known section with its default values and exit");
@@ -55,6 +58,9 @@ std::vector<Section> Sections() {
   return {
       MakeSection<swarmlio::LidarOptions>("lidar"),
       MakeSection<swarmlio::ImuOptions>("imu"),
+      MakeSection<swarmlio::teammate::TeammateDetectorOptions>("teammate"),
+      MakeSection<swarmlio::lio::OdometryOptions>("odometry"),
+      MakeSection<swarmlio::net::NetworkOptions>("network"),
   };
 }
 
