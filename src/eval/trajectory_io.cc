@@ -13,8 +13,8 @@ namespace swarmlio::eval {
 
 namespace {
 
-constexpr int kTumValues = 8;
-constexpr int kKittiValues = 12;
+constexpr size_t kTumValues = 8;
+constexpr size_t kKittiValues = 12;
 // A quaternion this close to zero has no defined rotation.
 constexpr double kMinQuaternionNorm = 1e-9;
 // Same tolerance as ValidateTrajectory (6-digit KITTI files).
@@ -78,6 +78,37 @@ Status FinishReading(const std::string& path, const std::ifstream& file, const T
   return Status::Ok();
 }
 
+// Reads a pose file line by line: comments and blank lines are skipped and
+// counted, every other line must hold exactly N finite numbers, which go to
+// `on_line(line_number, tokens, values, &trajectory, &stats)`.
+template <size_t N, class OnLine>
+Status ReadPoseLines(const std::string& path, Trajectory* trajectory, TrajectoryReadStats* stats,
+                     OnLine&& on_line) {
+  std::ifstream file;
+  SWARMLIO_RETURN_IF_ERROR(OpenForReading(path, &file));
+  Trajectory out;
+  TrajectoryReadStats counts;
+  std::string line;
+  std::vector<std::string> tokens;
+  int line_number = 0;
+  while (std::getline(file, line)) {
+    ++line_number;
+    if (!Tokenize(line, &tokens)) {
+      ++counts.skipped_lines;
+      continue;
+    }
+    std::array<double, N> v{};
+    const Status parsed = ParseNumbers(tokens, N, v.data());
+    if (!parsed.ok()) return Status::InvalidArgument(Where(path, line_number) + parsed.message());
+    SWARMLIO_RETURN_IF_ERROR(on_line(line_number, tokens, v, &out, &counts));
+  }
+  SWARMLIO_RETURN_IF_ERROR(FinishReading(path, file, out));
+  counts.pose_lines = static_cast<int>(out.size());
+  *trajectory = std::move(out);
+  if (stats != nullptr) *stats = counts;
+  return Status::Ok();
+}
+
 Status OpenForWriting(const std::string& path, std::FILE** file) {
   *file = std::fopen(path.c_str(), "w");
   if (*file == nullptr) return Status::IoError(path + ": cannot open for writing");
@@ -107,93 +138,62 @@ Status ReadTumTrajectory(const std::string& path,
                          const TrajectoryReadOptions& options,
                          Trajectory* trajectory,
                          TrajectoryReadStats* stats) {
-  std::ifstream file;
-  SWARMLIO_RETURN_IF_ERROR(OpenForReading(path, &file));
-  Trajectory out;
-  TrajectoryReadStats counts;
-  std::string line;
-  std::vector<std::string> tokens;
-  int line_number = 0;
   int previous_line = 0;
-  while (std::getline(file, line)) {
-    ++line_number;
-    if (!Tokenize(line, &tokens)) {
-      ++counts.skipped_lines;
-      continue;
-    }
-    std::array<double, kTumValues> v{};
-    const Status parsed = ParseNumbers(tokens, kTumValues, v.data());
-    if (!parsed.ok()) return Status::InvalidArgument(Where(path, line_number) + parsed.message());
-    const double stamp_s = v[0];
-    if (out.has_stamps()) {
-      const double previous_s = out.stamps_s.back();
-      const bool equal = stamp_s == previous_s;
-      if (stamp_s < previous_s || (equal && !options.allow_duplicate_stamps)) {
-        return Status::InvalidArgument(
-            Where(path, line_number) + "stamp " + tokens[0] + " does not increase (line " +
-            std::to_string(previous_line) + ")" +
-            (equal ? "; equal stamps are accepted with allow_duplicate_stamps" : ""));
-      }
-      if (equal) ++counts.duplicate_stamps;
-    }
-    // File order is x y z w; Eigen's constructor takes w x y z.
-    Eigen::Quaterniond q_G_b(v[7], v[4], v[5], v[6]);
-    if (q_G_b.norm() < kMinQuaternionNorm) {
-      return Status::InvalidArgument(Where(path, line_number) + "zero quaternion");
-    }
-    q_G_b.normalize();
-    Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
-    T_G_b.linear() = q_G_b.toRotationMatrix();
-    T_G_b.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-    out.stamps_s.push_back(stamp_s);
-    out.T_G_b.push_back(T_G_b);
-    previous_line = line_number;
-  }
-  SWARMLIO_RETURN_IF_ERROR(FinishReading(path, file, out));
-  counts.pose_lines = static_cast<int>(out.size());
-  *trajectory = std::move(out);
-  if (stats != nullptr) *stats = counts;
-  return Status::Ok();
+  return ReadPoseLines<kTumValues>(
+      path, trajectory, stats,
+      [&](int line_number, const std::vector<std::string>& tokens,
+          const std::array<double, kTumValues>& v, Trajectory* out,
+          TrajectoryReadStats* counts) {
+        const double stamp_s = v[0];
+        if (out->has_stamps()) {
+          const double previous_s = out->stamps_s.back();
+          const bool equal = stamp_s == previous_s;
+          if (stamp_s < previous_s || (equal && !options.allow_duplicate_stamps)) {
+            return Status::InvalidArgument(
+                Where(path, line_number) + "stamp " + tokens[0] + " does not increase (line " +
+                std::to_string(previous_line) + ")" +
+                (equal ? "; equal stamps are accepted with allow_duplicate_stamps" : ""));
+          }
+          if (equal) ++counts->duplicate_stamps;
+        }
+        // File order is x y z w; Eigen's constructor takes w x y z.
+        Eigen::Quaterniond q_G_b(v[7], v[4], v[5], v[6]);
+        if (q_G_b.norm() < kMinQuaternionNorm) {
+          return Status::InvalidArgument(Where(path, line_number) + "zero quaternion");
+        }
+        q_G_b.normalize();
+        Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+        T_G_b.linear() = q_G_b.toRotationMatrix();
+        T_G_b.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+        out->stamps_s.push_back(stamp_s);
+        out->T_G_b.push_back(T_G_b);
+        previous_line = line_number;
+        return Status::Ok();
+      });
 }
 
 Status ReadKittiTrajectory(const std::string& path,
                            Trajectory* trajectory,
                            TrajectoryReadStats* stats) {
-  std::ifstream file;
-  SWARMLIO_RETURN_IF_ERROR(OpenForReading(path, &file));
-  Trajectory out;
-  TrajectoryReadStats counts;
-  std::string line;
-  std::vector<std::string> tokens;
-  int line_number = 0;
-  while (std::getline(file, line)) {
-    ++line_number;
-    if (!Tokenize(line, &tokens)) {
-      ++counts.skipped_lines;
-      continue;
-    }
-    std::array<double, kKittiValues> v{};
-    const Status parsed = ParseNumbers(tokens, kKittiValues, v.data());
-    if (!parsed.ok()) return Status::InvalidArgument(Where(path, line_number) + parsed.message());
-    Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) T_G_b.matrix()(r, c) = v[static_cast<size_t>(4 * r + c)];
-    }
-    const Eigen::Matrix3d R = T_G_b.linear();
-    const double orthonormality_error =
-        (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    if (orthonormality_error > kMaxOrthonormalityError || R.determinant() <= 0.0) {
-      return Status::InvalidArgument(Where(path, line_number) +
-                                     "the 3 x 3 block is not a rotation (|R^T R - I| = " +
-                                     std::to_string(orthonormality_error) + ")");
-    }
-    out.T_G_b.push_back(T_G_b);
-  }
-  SWARMLIO_RETURN_IF_ERROR(FinishReading(path, file, out));
-  counts.pose_lines = static_cast<int>(out.size());
-  *trajectory = std::move(out);
-  if (stats != nullptr) *stats = counts;
-  return Status::Ok();
+  return ReadPoseLines<kKittiValues>(
+      path, trajectory, stats,
+      [&](int line_number, const std::vector<std::string>&,
+          const std::array<double, kKittiValues>& v, Trajectory* out, TrajectoryReadStats*) {
+        Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 4; ++c) T_G_b.matrix()(r, c) = v[static_cast<size_t>(4 * r + c)];
+        }
+        const Eigen::Matrix3d R = T_G_b.linear();
+        const double orthonormality_error =
+            (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+        if (orthonormality_error > kMaxOrthonormalityError || R.determinant() <= 0.0) {
+          return Status::InvalidArgument(Where(path, line_number) +
+                                         "the 3 x 3 block is not a rotation (|R^T R - I| = " +
+                                         std::to_string(orthonormality_error) + ")");
+        }
+        out->T_G_b.push_back(T_G_b);
+        return Status::Ok();
+      });
 }
 
 Status ReadTrajectory(const std::string& path,

@@ -91,6 +91,8 @@ class BagReader::Impl {
   const std::string& path() const { return path_; }
   LidarMessageType lidar_message_type() const { return lidar_type_; }
   bool has_ground_truth() const { return streams_.size() == 3; }
+  int64_t start_time_ns() const { return start_time_ns_; }
+  int64_t end_time_ns() const { return end_time_ns_; }
 
  private:
   // One topic streamed through its own index view, with one decoded record
@@ -127,6 +129,8 @@ class BagReader::Impl {
 
   std::string path_;
   BagReaderOptions options_;
+  int64_t start_time_ns_ = 0;
+  int64_t end_time_ns_ = 0;
   rosbag::Bag bag_;  // declared before streams_: the views point into it
   std::vector<TopicStream> streams_;
   LidarMessageType lidar_type_ = LidarMessageType::kPointCloud2;
@@ -219,6 +223,10 @@ Status BagReader::Impl::Open() {
   SWARMLIO_RETURN_IF_ERROR(internal::OpenBagForReading(path_, options_.verify_chunks, &bag_));
   try {
     rosbag::View all(bag_);
+    if (all.size() > 0) {
+      start_time_ns_ = internal::StampNsFromRosTime(all.getBeginTime());
+      end_time_ns_ = internal::StampNsFromRosTime(all.getEndTime());
+    }
     const std::vector<const rosbag::ConnectionInfo*> connections = all.getConnections();
     bool found_imu = false;
     bool found_lidar = false;
@@ -442,5 +450,7 @@ const BagReaderOptions& BagReader::options() const { return impl_->options(); }
 const std::string& BagReader::path() const { return impl_->path(); }
 LidarMessageType BagReader::lidar_message_type() const { return impl_->lidar_message_type(); }
 bool BagReader::has_ground_truth() const { return impl_->has_ground_truth(); }
+int64_t BagReader::start_time_ns() const { return impl_->start_time_ns(); }
+int64_t BagReader::end_time_ns() const { return impl_->end_time_ns(); }
 
 }  // namespace swarmlio::io

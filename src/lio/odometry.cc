@@ -257,7 +257,7 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
     out.iterations = result.iterations;
     out.converged = result.converged;
     out.num_correspondences = result.num_correspondences;
-    out.min_normal_information = im.associator.stats().normal_information(0);
+    out.min_normal_information = im.associator.stats().MinNormalInformation();
     out.degenerate = out.min_normal_information < options_.association.degeneracy_threshold;
     if (result.status.ok() && IsFinite(result.state, result.covariance)) {
       x = result.state;

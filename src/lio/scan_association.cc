@@ -5,6 +5,11 @@
 
 namespace swarmlio::lio {
 
+double AssociationStats::MinNormalInformation() const {
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(normal_information, Eigen::EigenvaluesOnly)
+      .eigenvalues()(0);
+}
+
 ScanAssociator::ScanAssociator(const LocalMap* map, const AssociationOptions& options)
     : map_(map), options_(options) {}
 
@@ -50,13 +55,9 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
     c.offset_m = cached.plane.offset_m;
     c.weight = weight;
     out->push_back(c);
+    stats_.normal_information += c.normal_in_G * c.normal_in_G.transpose();
   }
   stats_.num_correspondences = static_cast<int>(out->size());
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  for (const PlaneCorrespondence& c : *out) information += c.normal_in_G * c.normal_in_G.transpose();
-  stats_.normal_information = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
-                                  information, Eigen::EigenvaluesOnly)
-                                  .eigenvalues();
   return Status::Ok();
 }
 

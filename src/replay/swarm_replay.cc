@@ -5,7 +5,6 @@
 #include <limits>
 #include <variant>
 
-#include "swarmlio/io/bag_info.h"
 
 namespace swarmlio::replay {
 
@@ -29,10 +28,10 @@ Status SwarmReplay::Create(const SwarmManifest& manifest, std::unique_ptr<SwarmR
       errors += (errors.empty() ? "" : "; ") + status.message();
       continue;
     }
-    io::BagInfo info;
-    if (io::ReadBagInfo(input.bag_path, &info).ok() && info.message_count > 0) {
-      r->start_stamp_ns_ = std::min(r->start_stamp_ns_, info.start_time_ns);
-      r->end_stamp_ns_ = std::max(r->end_stamp_ns_, info.end_time_ns);
+    const io::BagReader& reader = runner->reader();
+    if (reader.end_time_ns() > 0) {
+      r->start_stamp_ns_ = std::min(r->start_stamp_ns_, reader.start_time_ns());
+      r->end_stamp_ns_ = std::max(r->end_stamp_ns_, reader.end_time_ns());
     }
     r->runners_.push_back(std::move(runner));
   }

@@ -201,6 +201,10 @@ void TeammateDetector::StartTrackers(double stamp_s, const Eigen::Isometry3d& T_
       }
     }
   }
+  RemoveTemporary(remove);
+}
+
+void TeammateDetector::RemoveTemporary(const std::vector<bool>& remove) {
   size_t kept = 0;
   for (size_t k = 0; k < temporary_.size(); ++k) {
     if (remove[k]) continue;
@@ -257,17 +261,7 @@ void TeammateDetector::Identify(double stamp_s, ScanResult* result) {
     id.num_pairs = match.match.num_pairs;
     result->identifications.push_back(id);
   }
-  size_t kept = 0;
-  for (size_t k = 0; k < temporary_.size(); ++k) {
-    if (remove[k]) continue;
-    if (kept != k) {
-      temporary_[kept] = std::move(temporary_[k]);
-      seen_temporary_[kept] = seen_temporary_[k];
-    }
-    ++kept;
-  }
-  temporary_.erase(temporary_.begin() + static_cast<std::ptrdiff_t>(kept), temporary_.end());
-  seen_temporary_.resize(kept);
+  RemoveTemporary(remove);
 }
 
 void TeammateDetector::FillOutputs(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,

@@ -37,5 +37,13 @@ TEST(ErrorStatistics, Errors) {
   EXPECT_FALSE(ComputeErrorStatistics({std::numeric_limits<double>::infinity()}, &s).ok());
 }
 
+TEST(Percentile, InterpolatesBetweenOrderStatistics) {
+  EXPECT_EQ(Percentile({}, 0.5), 0.0);
+  EXPECT_EQ(Percentile({3.0, 1.0, 2.0, 4.0}, 0.5), 2.5);  // the median
+  EXPECT_EQ(Percentile({3.0, 1.0, 2.0, 4.0}, 0.0), 1.0);
+  EXPECT_EQ(Percentile({3.0, 1.0, 2.0, 4.0}, 1.0), 4.0);
+  EXPECT_DOUBLE_EQ(Percentile({0.0, 10.0}, 0.95), 9.5);
+}
+
 }  // namespace
 }  // namespace swarmlio::eval

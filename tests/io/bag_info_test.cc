@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
+
+#include "swarmlio/io/bag_reader.h"
 
 #include "tests/io/bag_test_util.h"
 #include "tests/io/io_test_util.h"
@@ -34,6 +37,12 @@ TEST(BagInfoTest, ListsTopicsCountsAndTimes) {
   EXPECT_EQ(info.topics[2].topic, "/livox/lidar");
   EXPECT_EQ(info.topics[2].md5sum, "e4d6829bdfe657cb6c21a746c86b21a6");
   EXPECT_EQ(info.topics[2].message_count, 2);
+
+  // The streaming reader reports the same bag time range.
+  std::unique_ptr<BagReader> reader;
+  ASSERT_TRUE(BagReader::Open(path, BagReaderOptions(), &reader).ok());
+  EXPECT_EQ(reader->start_time_ns(), info.start_time_ns);
+  EXPECT_EQ(reader->end_time_ns(), info.end_time_ns);
 }
 
 TEST(BagInfoTest, MissingFileIsNotFound) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "swarmlio/eval/drone_metrics.h"
+#include "swarmlio/eval/error_statistics.h"
 #include "swarmlio/eval/plots.h"
 #include "swarmlio/eval/trajectory_io.h"
 #include "swarmlio/io/pcd_writer.h"
@@ -17,15 +18,6 @@ namespace swarmlio::tools {
 namespace {
 
 namespace fs = std::filesystem;
-
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = p * static_cast<double>(v.size() - 1);
-  const size_t lo = static_cast<size_t>(pos);
-  const size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
 
 eval::Trajectory EstimateTrajectory(const std::vector<replay::ScanRecord>& scans) {
   eval::Trajectory t;
@@ -136,8 +128,8 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
                                               : StampSeconds(d.scans().back().stamp_ns -
                                                              d.scans().front().stamp_ns);
     std::vector<std::pair<std::string, double>> extra = {{"scans", static_cast<double>(d.scans().size())},
-               {"time_median_ms", Percentile(total_ms, 0.5)},
-               {"time_p95_ms", Percentile(total_ms, 0.95)},
+               {"time_median_ms", eval::Percentile(total_ms, 0.5)},
+               {"time_p95_ms", eval::Percentile(total_ms, 0.95)},
                {"realtime_factor", busy_s > 0.0 ? log_s / busy_s : 0.0}};
 
     // Ground truth: the manifest's TUM file, else the bag's topic.

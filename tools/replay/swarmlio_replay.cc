@@ -26,6 +26,7 @@
 #include "progress_bar.h"
 #include "report.h"
 #include "swarmlio/config/config_file.h"
+#include "swarmlio/eval/error_statistics.h"
 #include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
@@ -55,12 +56,6 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
-double Median(std::vector<double> v, double p = 0.5) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
-}
-
 struct StageStats {
   const char* name;
   double lio::ScanTimings::*field;
@@ -87,8 +82,8 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     std::printf("  IMU init: %s\n", d.odometry().initialization().Summary().c_str());
   }
   if (!total.empty()) {
-    std::printf("  per-scan time [ms]: median %.2f  p95 %.2f  max %.2f", Median(total),
-                Median(total, 0.95), Median(total, 1.0));
+    std::printf("  per-scan time [ms]: median %.2f  p95 %.2f  max %.2f", eval::Percentile(total, 0.5),
+                eval::Percentile(total, 0.95), eval::Percentile(total, 1.0));
     const StageStats stages[] = {{"preprocess", &lio::ScanTimings::preprocess_s},
                                  {"propagate", &lio::ScanTimings::propagate_s},
                                  {"undistort", &lio::ScanTimings::undistort_s},
@@ -102,7 +97,7 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
       for (const auto& s : scans) {
         if (s.updated) v.push_back(1e3 * (s.timings.*st.field));
       }
-      std::printf(" %s %.2f", st.name, Median(v));
+      std::printf(" %s %.2f", st.name, eval::Percentile(v, 0.5));
     }
     std::printf("\n");
   }

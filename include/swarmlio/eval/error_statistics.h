@@ -22,4 +22,8 @@ struct ErrorStatistics {
 /// Errors: an empty list, a non-finite value.
 Status ComputeErrorStatistics(const std::vector<double>& errors, ErrorStatistics* statistics);
 
+/// The `fraction` quantile (0 = min, 0.5 = median, 1 = max) with linear
+/// interpolation between order statistics (numpy's default); 0 for an empty list.
+double Percentile(std::vector<double> values, double fraction);
+
 }  // namespace swarmlio::eval

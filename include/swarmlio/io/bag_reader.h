@@ -60,6 +60,10 @@ class BagReader {
   const std::string& path() const;
   LidarMessageType lidar_message_type() const;
   bool has_ground_truth() const;
+  /// Bag (receive) time of the first and last message of the whole bag, as
+  /// ReadBagInfo reports them (0 for an empty bag).
+  int64_t start_time_ns() const;
+  int64_t end_time_ns() const;
 
  private:
   class Impl;

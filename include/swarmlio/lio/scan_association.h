@@ -84,9 +84,12 @@ struct AssociationStats {
   int num_no_plane = 0;       // too few / too far neighbours, not planar
   int num_gated = 0;          // plane found, residual too large
   int num_correspondences = 0;
-  /// Eigenvalues of sum_n n_n n_n^T over the correspondences, ascending: how
-  /// well the planes constrain the translation in each direction.
-  Eigen::Vector3d normal_information = Eigen::Vector3d::Zero();
+  /// sum_n n_n n_n^T over the correspondences: how well the planes constrain
+  /// the translation in each direction (see MinNormalInformation()).
+  Eigen::Matrix3d normal_information = Eigen::Matrix3d::Zero();
+
+  /// Smallest eigenvalue of normal_information (the degeneracy metric).
+  double MinNormalInformation() const;
 };
 
 class ScanAssociator {

@@ -120,6 +120,8 @@ class TeammateDetector {
   void StartTrackers(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
                      const std::vector<bool>& available);
   void Identify(double stamp_s, ScanResult* result);
+  // Drops the temporary trackers k with remove[k] (keeps the others' order).
+  void RemoveTemporary(const std::vector<bool>& remove);
   void FillOutputs(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
                    const std::vector<ScanPoint>& points, ScanResult* result);
   // A cluster in the predicted region around `center_in_b`, drone-sized and
