@@ -1,9 +1,11 @@
 #include "swarmlio/lio/esikf_update.h"
 
 #include <ceres/problem.h>
+#include <ceres/crs_matrix.h>
 #include <ceres/solver.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <memory>
@@ -12,6 +14,7 @@
 #include "factors/ego_state_manifold.h"
 #include "factors/global_extrinsic_manifold.h"
 #include "factors/prior_factor.h"
+#include "swarmlio/math/so3.h"
 
 namespace swarmlio {
 namespace {
@@ -90,30 +93,48 @@ bool StepIsSmall(const Eigen::VectorXd& dx,
   return small;
 }
 
-// (J^T J)^-1 at x with J = [prior tangent Jacobian; point-to-plane H].
-bool PosteriorCovariance(const PriorFactor& prior,
-                         const PointToPlaneFactor& points,
-                         bool with_points,
-                         const SwarmState& x,
-                         Eigen::MatrixXd* P) {
-  const Eigen::MatrixXd J_prior = prior.TangentJacobian(x);
-  Eigen::MatrixXd information = J_prior.transpose() * J_prior;
-  if (with_points) {
-    Eigen::Matrix<double, 6, 6> HtH = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> Htz = Eigen::Matrix<double, 6, 1>::Zero();
-    points.AccumulateNormalEquations(x.ego, &HtH, &Htz);
-    static_assert(ErrorStateLayout::kRotation.offset == 0 &&
-                  ErrorStateLayout::kPosition.offset == 3);
-    information.topLeftCorner<6, 6>() += HtH;
+// Rows/columns of `layout` that a sub-layout with teammates `ids` keeps, in
+// the sub-layout's order.
+std::vector<int> SubsetIndices(const ErrorStateLayout& layout, const std::vector<int>& ids) {
+  std::vector<int> idx;
+  for (int k = 0; k < ErrorStateLayout::kEgoDim; ++k) idx.push_back(k);
+  for (int id : ids) {
+    const Segment s = layout.TeammateBlock(id);
+    for (int k = s.offset; k < s.end(); ++k) idx.push_back(k);
   }
-  const Eigen::LLT<Eigen::MatrixXd> llt(information);
-  if (llt.info() != Eigen::Success) return false;
-  *P = llt.solve(Eigen::MatrixXd::Identity(x.Dim(), x.Dim()));
-  *P = 0.5 * (*P + P->transpose());
-  return true;
+  return idx;
+}
+
+SwarmState SubsetState(const SwarmState& x, const std::vector<int>& ids) {
+  SwarmState sub;
+  sub.ego = x.ego;
+  for (int id : ids) sub.AddTeammate(id, x.teammate(id));
+  return sub;
+}
+
+Eigen::MatrixXd Gather(const Eigen::MatrixXd& P, const std::vector<int>& rows,
+                       const std::vector<int>& cols) {
+  Eigen::MatrixXd out(rows.size(), cols.size());
+  for (size_t r = 0; r < rows.size(); ++r) {
+    for (size_t c = 0; c < cols.size(); ++c) out(r, c) = P(rows[r], cols[c]);
+  }
+  return out;
 }
 
 }  // namespace
+
+PlaneMeasurementModel::PlaneMeasurementModel(PlaneAssociationFn associate)
+    : associate_(std::move(associate)), factor_(&correspondences_) {}
+
+Status PlaneMeasurementModel::Linearize(const SwarmState& x, std::vector<ResidualTerm>* terms) {
+  if (!associate_) return Status::InvalidArgument("no association callback");
+  correspondences_.clear();
+  SWARMLIO_RETURN_IF_ERROR(associate_(x, &correspondences_));
+  factor_.SyncNumResiduals();  // the update removed last iteration's block
+  if (!correspondences_.empty()) terms->push_back({&factor_, {kEgoBlock}});
+  return Status::Ok();
+}
+
 
 std::string EsikfUpdateOptions::Validate() const {
   const std::string fields = config::ValidateFields(*this);
@@ -136,6 +157,108 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat,
                                        const Eigen::MatrixXd& P_hat,
                                        const SwarmState& x_start,
                                        const PlaneAssociationFn& associate) const {
+  if (!associate) {
+    EsikfUpdateResult result;
+    result.state = x_hat;
+    result.covariance = P_hat;
+    result.status = Status::InvalidArgument("EsikfUpdate: no association callback");
+    return result;
+  }
+  PlaneMeasurementModel planes(associate);
+  EsikfUpdateResult result = RunFrom(x_hat, P_hat, x_start, {&planes});
+  result.num_correspondences = static_cast<int>(planes.correspondences().size());
+  return result;
+}
+
+EsikfUpdateResult EsikfUpdate::Run(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
+                                   const std::vector<MeasurementModel*>& models,
+                                   const std::vector<int>* estimated_teammates) const {
+  return RunFrom(x_hat, P_hat, x_hat, models, estimated_teammates);
+}
+
+EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
+                                       const SwarmState& x_start,
+                                       const std::vector<MeasurementModel*>& models,
+                                       const std::vector<int>* estimated_teammates) const {
+  if (estimated_teammates == nullptr ||
+      *estimated_teammates == x_hat.layout().teammate_ids()) {
+    return RunAll(x_hat, P_hat, x_start, models);
+  }
+  EsikfUpdateResult result;
+  result.state = x_hat;
+  result.covariance = P_hat;
+  const ErrorStateLayout& layout = x_hat.layout();
+  // Estimated teammates in layout order; every id must be present.
+  std::vector<int> ids;
+  for (int id : layout.teammate_ids()) {
+    if (std::find(estimated_teammates->begin(), estimated_teammates->end(), id) !=
+        estimated_teammates->end()) {
+      ids.push_back(id);
+    }
+  }
+  if (ids.size() != estimated_teammates->size()) {
+    result.status = Status::InvalidArgument(
+        "EsikfUpdate: estimated_teammates names a teammate absent from the state (or twice)");
+    return result;
+  }
+  if (P_hat.rows() != x_hat.Dim() || P_hat.cols() != x_hat.Dim() ||
+      x_start.layout() != layout) {
+    result.status = Status::InvalidArgument("EsikfUpdate: P_hat / x_start do not match x_hat");
+    return result;
+  }
+  const std::vector<int> s_idx = SubsetIndices(layout, ids);
+  std::vector<int> o_idx;
+  for (int k = 0; k < x_hat.Dim(); ++k) {
+    if (std::find(s_idx.begin(), s_idx.end(), k) == s_idx.end()) o_idx.push_back(k);
+  }
+  const Eigen::MatrixXd P_ss = Gather(P_hat, s_idx, s_idx);
+  EsikfUpdateResult sub =
+      RunAll(SubsetState(x_hat, ids), P_ss, SubsetState(x_start, ids), models);
+  result.status = sub.status;
+  result.iterations = sub.iterations;
+  result.converged = sub.converged;
+  result.num_residual_blocks = sub.num_residual_blocks;
+  result.num_rejected_steps = sub.num_rejected_steps;
+  result.association_time_s = sub.association_time_s;
+  result.solve_time_s = sub.solve_time_s;
+  result.covariance_time_s = sub.covariance_time_s;
+  result.total_time_s = sub.total_time_s;
+  if (!sub.status.ok()) return result;
+
+  // Schmidt-Kalman: x_o and P_oo unchanged, P_os^+ = P_os (I - K H)^T in
+  // the tangent space at the solution, i.e. P_os P_ss^-1 J P_ss^+ with J =
+  // d(x (-) x_hat)/d dx at the solution (identity at x_hat; docs/esikf.md).
+  const Clock::time_point t_cov = Clock::now();
+  result.state.ego = sub.state.ego;
+  for (int id : ids) result.state.teammate(id) = sub.state.teammate(id);
+  const SwarmState x_hat_s = SubsetState(x_hat, ids);
+  const Eigen::VectorXd e = sub.state.BoxMinus(x_hat_s);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Identity(x_hat_s.Dim(), x_hat_s.Dim());
+  J.block<3, 3>(0, 0) = so3::RightJacobianInverse(e.head<3>());
+  for (int id : ids) {
+    const int o = x_hat_s.layout().TeammateRotation(id).offset;
+    J.block<3, 3>(o, o) = so3::RightJacobianInverse(e.segment<3>(o));
+  }
+  const Eigen::MatrixXd P_os = Gather(P_hat, o_idx, s_idx);
+  const Eigen::MatrixXd P_os_plus =
+      P_ss.llt().solve(P_os.transpose()).transpose() * J * sub.covariance;
+  Eigen::MatrixXd& P = result.covariance;
+  for (size_t r = 0; r < s_idx.size(); ++r) {
+    for (size_t c = 0; c < s_idx.size(); ++c) P(s_idx[r], s_idx[c]) = sub.covariance(r, c);
+  }
+  for (size_t r = 0; r < o_idx.size(); ++r) {
+    for (size_t c = 0; c < s_idx.size(); ++c) {
+      P(o_idx[r], s_idx[c]) = P(s_idx[c], o_idx[r]) = P_os_plus(r, c);
+    }
+  }
+  result.covariance_time_s += SecondsSince(t_cov);
+  return result;
+}
+
+EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
+                                      const Eigen::MatrixXd& P_hat,
+                                      const SwarmState& x_start,
+                                      const std::vector<MeasurementModel*>& models) const {
   const Clock::time_point t_start = Clock::now();
   EsikfUpdateResult result;
   result.state = x_hat;
@@ -151,7 +274,9 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat,
   if (x_start.layout() != x_hat.layout()) {
     return fail(Status::InvalidArgument("EsikfUpdate: x_start and x_hat have different layouts"));
   }
-  if (!associate) return fail(Status::InvalidArgument("EsikfUpdate: no association callback"));
+  for (const MeasurementModel* m : models) {
+    if (m == nullptr) return fail(Status::InvalidArgument("EsikfUpdate: null measurement model"));
+  }
   Eigen::MatrixXd cholesky;
   if (P_hat.rows() != x_hat.Dim() || !PriorFactor::CholeskyOfCovariance(P_hat, &cholesky)) {
     return fail(Status::InvalidArgument(
@@ -163,13 +288,12 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat,
   EgoStateManifold ego_manifold;
   GlobalExtrinsicManifold teammate_manifold;
   PriorFactor prior(x_hat, std::move(cholesky));
-  std::vector<PlaneCorrespondence> correspondences;
-  PointToPlaneFactor points(&correspondences);
   ParameterBlocks blocks(x_start);
 
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.enable_fast_removal = true;
   ceres::Problem problem(problem_options);
   const std::vector<double*>& pointers = blocks.pointers();
   problem.AddParameterBlock(pointers[0], EgoState::kAmbientSize, &ego_manifold);
@@ -177,26 +301,48 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat,
     problem.AddParameterBlock(pointers[b], GlobalExtrinsic::kAmbientSize, &teammate_manifold);
   }
   problem.AddResidualBlock(&prior, nullptr, pointers);
-  ceres::ResidualBlockId point_block = nullptr;
+  std::vector<ceres::ResidualBlockId> measurement_blocks;
+  std::vector<ResidualTerm> terms;
+  std::vector<double*> term_pointers;
 
   const ceres::Solver::Options solver_options = GaussNewtonSolverOptions(options_);
   SwarmState x = x_start;
   for (int it = 0; it < options_.max_iterations; ++it) {
-    // Re-associate at the current estimate and swap the point residual block.
+    // Drop last iteration's measurement blocks, re-linearize every model at x.
+    for (ceres::ResidualBlockId id : measurement_blocks) problem.RemoveResidualBlock(id);
+    measurement_blocks.clear();
+    terms.clear();
     const Clock::time_point t_assoc = Clock::now();
-    correspondences.clear();
-    const Status assoc = associate(x, &correspondences);
+    for (MeasurementModel* model : models) {
+      const Status status = model->Linearize(x, &terms);
+      if (!status.ok()) {
+        result.association_time_s += SecondsSince(t_assoc);
+        return fail(status.WithContext(std::string("EsikfUpdate: ") + model->name()));
+      }
+    }
     result.association_time_s += SecondsSince(t_assoc);
-    if (!assoc.ok()) return fail(assoc.WithContext("EsikfUpdate: association"));
-    if (point_block != nullptr) {
-      problem.RemoveResidualBlock(point_block);
-      point_block = nullptr;
+    for (const ResidualTerm& term : terms) {
+      term_pointers.clear();
+      for (int block : term.blocks) {
+        if (block == kEgoBlock) {
+          term_pointers.push_back(pointers[0]);
+        } else if (x.layout().HasTeammate(block)) {
+          term_pointers.push_back(pointers[static_cast<size_t>(x.layout().SlotOf(block)) + 1]);
+        } else {
+          return fail(Status::InvalidArgument("EsikfUpdate: a residual block names teammate " +
+                                              std::to_string(block) +
+                                              ", absent from the estimated state"));
+        }
+      }
+      if (term.cost == nullptr ||
+          term.cost->parameter_block_sizes().size() != term_pointers.size()) {
+        return fail(Status::InvalidArgument(
+            "EsikfUpdate: a residual block's cost does not match its block list"));
+      }
+      measurement_blocks.push_back(problem.AddResidualBlock(
+          const_cast<ceres::CostFunction*>(term.cost), nullptr, term_pointers));
     }
-    points.SyncNumResiduals();
-    if (!correspondences.empty()) {
-      point_block = problem.AddResidualBlock(&points, nullptr, pointers[0]);
-    }
-    result.num_correspondences = static_cast<int>(correspondences.size());
+    result.num_residual_blocks = static_cast<int>(measurement_blocks.size());
 
     const Clock::time_point t_solve = Clock::now();
     ceres::Solver::Summary summary;
@@ -218,11 +364,38 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat,
     }
   }
 
+  // Posterior (J^T J)^-1 at the final estimate: the tangent Jacobian of every
+  // residual block, columns in ErrorStateLayout order (the parameter blocks
+  // in layout order, each in its manifold's tangent space).
   const Clock::time_point t_cov = Clock::now();
-  Eigen::MatrixXd P;
-  if (!PosteriorCovariance(prior, points, point_block != nullptr, x, &P)) {
+  blocks.Write(x);
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = pointers;
+  evaluate.apply_loss_function = false;
+  evaluate.num_threads = 1;
+  ceres::CRSMatrix crs;
+  if (!problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs) || crs.num_cols != x.Dim()) {
+    return fail(Status::Internal("EsikfUpdate: Jacobian evaluation failed"));
+  }
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(x.Dim(), x.Dim());
+  for (int r = 0; r < crs.num_rows; ++r) {
+    const int begin = crs.rows[static_cast<size_t>(r)];
+    const int end = crs.rows[static_cast<size_t>(r) + 1];
+    for (int a = begin; a < end; ++a) {
+      const double va = crs.values[static_cast<size_t>(a)];
+      if (va == 0.0) continue;  // point rows: 6 of 18 ego columns are non-zero
+      const int ca = crs.cols[static_cast<size_t>(a)];
+      for (int b = begin; b < end; ++b) {
+        information(ca, crs.cols[static_cast<size_t>(b)]) += va * crs.values[static_cast<size_t>(b)];
+      }
+    }
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(information);
+  if (llt.info() != Eigen::Success) {
     return fail(Status::Internal("EsikfUpdate: posterior information is not positive definite"));
   }
+  Eigen::MatrixXd P = llt.solve(Eigen::MatrixXd::Identity(x.Dim(), x.Dim()));
+  P = 0.5 * (P + P.transpose());
   result.covariance_time_s = SecondsSince(t_cov);
   result.state = std::move(x);
   result.covariance = std::move(P);

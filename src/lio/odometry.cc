@@ -59,6 +59,7 @@ struct Odometry::Impl {
   bool have_imu = false;
   int64_t last_scan_end_ns = 0;
   bool have_scan = false;
+  bool previous_degenerate = false;  // the last updated scan's flag (front end)
   // Scratch reused between scans.
   std::vector<PointXYZT> points_in_b;
   std::vector<Eigen::Vector3d> undistorted;
@@ -240,23 +241,46 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
                                            &im.undistorted));
   out.timings.undistort_s = SecondsSince(t);
 
-  // 4. Update.
+  // 3b. Front end of the hooks (may change the state's teammate blocks).
   SwarmState x = prop.state();
   Eigen::MatrixXd P = prop.covariance();
+  UpdateRequest request;
+  if (hooks_ != nullptr) {
+    t = Clock::now();
+    FrontEndScan front;
+    front.raw = &scan;
+    front.end_stamp_ns = prop.stamp_ns();
+    front.poses = &prop.scan_poses();
+    front.previous_scan_degenerate = im.previous_degenerate;
+    const Status status = hooks_->OnFrontEnd(front, &x, &P, &request);
+    if (!status.ok()) {
+      out.hook_error = status.message();
+      request = UpdateRequest();
+    }
+    if (x.layout() != prop.state().layout()) prop.SetState(x, P);
+    out.timings.front_end_s = SecondsSince(t);
+  }
+
+  // 4. Update.
   const bool map_ready = !im.map.empty();
   const bool enough_points = static_cast<int>(im.undistorted.size()) >= options_.min_scan_points;
   if (map_ready && enough_points) {
     im.associator.Reset(&im.undistorted);
-    const EsikfUpdateResult result = im.update.Run(
-        x, P, [&](const SwarmState& at, std::vector<PlaneCorrespondence>* correspondences) {
+    PlaneMeasurementModel planes(
+        [&](const SwarmState& at, std::vector<PlaneCorrespondence>* correspondences) {
           return im.associator.Associate(at, correspondences);
         });
+    std::vector<MeasurementModel*> models{&planes};
+    models.insert(models.end(), request.models.begin(), request.models.end());
+    const EsikfUpdateResult result =
+        im.update.Run(x, P, models, hooks_ != nullptr ? &request.estimated_teammates : nullptr);
     out.timings.association_s = result.association_time_s;
     out.timings.solve_s = result.solve_time_s;
     out.timings.covariance_s = result.covariance_time_s;
     out.iterations = result.iterations;
     out.converged = result.converged;
-    out.num_correspondences = result.num_correspondences;
+    out.num_correspondences = static_cast<int>(planes.correspondences().size());
+    out.num_measurement_blocks = result.num_residual_blocks;
     out.min_normal_information = im.associator.stats().MinNormalInformation();
     out.degenerate = out.min_normal_information < options_.association.degeneracy_threshold;
     if (result.status.ok() && IsFinite(result.state, result.covariance)) {
@@ -265,6 +289,7 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
       out.updated = true;
       ++counters_.scans_updated;
       if (out.degenerate) ++counters_.scans_degenerate;
+      im.previous_degenerate = out.degenerate;
       prop.SetState(x, P);
     } else {
       ++counters_.updates_failed;
@@ -272,15 +297,26 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
     }
   }
 
-  // 5. Map: register with the (posterior) state and insert. Only updated
-  // scans and the very first one grow the map, so a failed update cannot
-  // write a misregistered scan into it.
+  // 4b + 5. Map: register with the (posterior) state and insert, except the
+  // points in the excluded regions (teammates). Only updated scans and the
+  // very first one grow the map, so a failed update cannot write a
+  // misregistered scan into it.
   t = Clock::now();
   if (out.updated || !map_ready) {
     const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
     std::vector<Eigen::Vector3d> registered;
     registered.reserve(im.undistorted.size());
-    for (const Eigen::Vector3d& p : im.undistorted) registered.push_back(R_G_b * p + x.ego.p_b_in_G);
+    for (const Eigen::Vector3d& p : im.undistorted) {
+      bool excluded = false;
+      for (const ExcludedRegion& region : request.excluded) {
+        excluded |= (p - region.center_in_b).squaredNorm() <= region.radius_m * region.radius_m;
+      }
+      if (excluded) {
+        ++out.num_excluded_points;
+        continue;
+      }
+      registered.push_back(R_G_b * p + x.ego.p_b_in_G);
+    }
     im.map.UpdateCenter(x.ego.p_b_in_G);
     im.map.Insert(registered);
     if (options_.output_registered_scan) out.registered_in_G = std::move(registered);
@@ -295,6 +331,7 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
   im.last_scan_end_ns = end_ns;
   im.have_scan = true;
   ++counters_.scans_processed;
+  if (hooks_ != nullptr) hooks_->OnScanDone(out, x, P);
   im.outputs.push_back(std::move(out));
   return first_error;
 }

@@ -4,12 +4,17 @@
 
 namespace swarmlio::replay {
 
-Status DroneRunner::Create(const DroneInput& input, std::unique_ptr<DroneRunner>* runner) {
+Status DroneRunner::Create(const DroneInput& input, int drone_id,
+                           std::unique_ptr<DroneRunner>* runner) {
   std::unique_ptr<DroneRunner> r(new DroneRunner());
   r->input_ = input;
   Status status = io::BagReader::Open(input.bag_path, input.bag, &r->reader_);
   if (!status.ok()) return status.WithContext(input.name);
-  status = lio::Odometry::Create(input.odometry, input.lidar, &r->odometry_);
+  swarm::DroneEstimatorOptions options;
+  options.odometry = input.odometry;
+  options.teammate = input.teammate;
+  options.swarm = input.swarm;
+  status = swarm::DroneEstimator::Create(drone_id, options, input.lidar, &r->estimator_);
   if (!status.ok()) return status.WithContext(input.name);
   status = r->ReadNext();
   if (!status.ok()) return status.WithContext(input.name);
@@ -36,6 +41,38 @@ ScanRecord ToScanRecord(const lio::ScanOutput& o) {
   return r;
 }
 
+ScanRecord ToScanRecord(const swarm::DroneOutput& o) {
+  ScanRecord r = ToScanRecord(o.ego);
+  for (const swarm::TeammateEstimate& e : o.teammates) {
+    TeammateRecord t;
+    t.drone_id = e.drone_id;
+    t.T_Gi_Gj = e.T_Gi_Gj;
+    t.extrinsic_sigma2 = e.extrinsic_covariance.diagonal();
+    t.have_pose = e.have_pose;
+    t.q_Gi_bj = e.q_Gi_bj;
+    t.p_bj_in_Gi = e.p_bj_in_Gi;
+    t.seen = e.seen;
+    t.active_observations = e.active_observations;
+    t.passive_observations = e.passive_observations;
+    r.teammates.push_back(t);
+  }
+  r.active_observations = o.active_observations;
+  r.passive_observations = o.passive_observations;
+  r.rejected_observations = o.rejected_observations;
+  r.extrinsics_frozen = o.extrinsics_frozen;
+  return r;
+}
+
+void DroneRunner::Deliver(const net::ReceivedMessage& message) {
+  Warn(estimator_->AddMessage(message));
+}
+
+void DroneRunner::TakeMessages(std::vector<net::SwarmMessage>* messages) {
+  estimator_->PopMessages(messages);
+}
+
+void DroneRunner::SetFusion(bool fuse) { estimator_->SetFusion(fuse); }
+
 int64_t DroneRunner::next_stamp_ns() const { return next_.stamp_ns(); }
 
 Status DroneRunner::ReadNext() {
@@ -51,9 +88,9 @@ void DroneRunner::Warn(const Status& status) {
 Status DroneRunner::Step() {
   if (!has_next_) return Status::OutOfRange(input_.name + ": no record left");
   if (const ImuSample* imu = next_.imu()) {
-    Warn(odometry_->AddImu(*imu));
+    Warn(estimator_->AddImu(*imu));
   } else if (const LidarScan* scan = next_.scan()) {
-    Warn(odometry_->AddScan(*scan));
+    Warn(estimator_->AddScan(*scan));
   } else if (const PoseStamped* pose = next_.ground_truth()) {
     ground_truth_.push_back(*pose);
   }
@@ -63,17 +100,19 @@ Status DroneRunner::Step() {
 }
 
 Status DroneRunner::Finish() {
-  Warn(odometry_->Flush());
+  Warn(estimator_->Flush());
   Collect();
   return Status::Ok();
 }
 
 void DroneRunner::Collect() {
   outputs_.clear();
-  odometry_->PopOutputs(&outputs_);
-  for (const lio::ScanOutput& o : outputs_) {
+  estimator_->PopOutputs(&outputs_);
+  for (const swarm::DroneOutput& o : outputs_) {
     scans_.push_back(ToScanRecord(o));
-    if (!o.update_error.empty()) Warn(Status::Internal("update failed: " + o.update_error));
+    for (const swarm::IdentificationEvent& e : o.identifications) identifications_.push_back(e);
+    if (!o.ego.update_error.empty()) Warn(Status::Internal("update failed: " + o.ego.update_error));
+    if (!o.ego.hook_error.empty()) Warn(Status::Internal("swarm front end: " + o.ego.hook_error));
   }
 }
 

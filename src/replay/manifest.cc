@@ -24,6 +24,8 @@ struct DroneEntry {
   ImuOptions imu;
   io::BagReaderOptions bag_topics;
   lio::OdometryOptions odometry;
+  teammate::TeammateDetectorOptions teammate;
+  swarm::SwarmOptions swarm;
   Eigen::Vector3d p_G_in_W_m = Eigen::Vector3d::Zero();
   std::vector<double> q_W_G_xyzw = {0.0, 0.0, 0.0, 1.0};
 
@@ -39,6 +41,8 @@ struct DroneEntry {
     v("imu", imu);
     v("bag_topics", bag_topics);
     v("odometry", odometry);
+    v("teammate", teammate);
+    v("swarm", swarm);
     v("p_G_in_W_m", p_G_in_W_m,
       FieldSpec::InRange(-1e7, 1e7, "m", "origin of G in a common world frame (plots only)"));
     v("q_W_G_xyzw", q_W_G_xyzw,
@@ -127,6 +131,8 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".imu", &d.imu));
     d.odometry = DefaultOdometryOptions(d.lidar, d.imu);
     SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".odometry", &d.odometry));
+    SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".teammate", &d.teammate));
+    SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".swarm", &d.swarm));
     d.bag.point_time_unit = file.HasKey(key + ".bag_topics.point_time_unit")
                                 ? d.bag.point_time_unit
                                 : d.lidar.timestamp_unit;

@@ -21,9 +21,10 @@ Status SwarmReplay::Create(const SwarmManifest& manifest, std::unique_ptr<SwarmR
   std::string errors;
   r->start_stamp_ns_ = std::numeric_limits<int64_t>::max();
   r->end_stamp_ns_ = std::numeric_limits<int64_t>::min();
-  for (const DroneInput& input : manifest.drones) {
+  for (size_t i = 0; i < manifest.drones.size(); ++i) {
+    const DroneInput& input = manifest.drones[i];
     std::unique_ptr<DroneRunner> runner;
-    const Status status = DroneRunner::Create(input, &runner);
+    const Status status = DroneRunner::Create(input, static_cast<int>(i), &runner);
     if (!status.ok()) {
       errors += (errors.empty() ? "" : "; ") + status.message();
       continue;
@@ -49,7 +50,7 @@ Status SwarmReplay::SetUpNetwork(const ReplayOptions& options) {
   traffic_.assign(runners_.size(), DroneTraffic());
   channels_.clear();
   network_.reset();
-  if (options.single_agent) return Status::Ok();
+  for (auto& runner : runners_) runner->SetFusion(!options.single_agent);
   std::vector<int> ids;
   for (size_t i = 0; i < runners_.size(); ++i) ids.push_back(static_cast<int>(i));
   SWARMLIO_RETURN_IF_ERROR(net::SimulatedNetwork::Create(options.network, ids, &network_));
@@ -61,22 +62,14 @@ Status SwarmReplay::SetUpNetwork(const ReplayOptions& options) {
   return Status::Ok();
 }
 
-Status SwarmReplay::Broadcast(int drone, size_t first_new_scan) {
-  const std::vector<ScanRecord>& scans = runners_[drone]->scans();
-  for (size_t k = first_new_scan; k < scans.size(); ++k) {
-    const ScanRecord& r = scans[k];
-    net::EgoStateMessage m;
-    m.sender_id = drone;
-    m.stamp_ns = r.stamp_ns;
-    m.session_start_ns = runners_[drone]->odometry().initialization().stamp_ns;
-    m.q_Gj_bj = r.state.q_G_b.normalized();
-    m.p_bj_in_Gj = r.state.p_b_in_G;
-    m.v_bj_in_Gj = r.state.v_b_in_G;
-    m.cov_theta_Gj_bj = r.pose_covariance.topLeftCorner<3, 3>();
-    m.cov_p_bj_in_Gj = r.pose_covariance.bottomRightCorner<3, 3>();
-    m.cov_v_bj_in_Gj = r.velocity_covariance;
-    m.degenerated = r.degenerate;
-    SWARMLIO_RETURN_IF_ERROR(channels_[drone]->Send(r.stamp_ns, net::kBroadcastId, m));
+Status SwarmReplay::Broadcast(int drone) {
+  outbox_.clear();
+  runners_[drone]->TakeMessages(&outbox_);
+  for (const net::SwarmMessage& m : outbox_) {
+    const int64_t stamp_ns = std::holds_alternative<net::EgoStateMessage>(m)
+                                 ? std::get<net::EgoStateMessage>(m).stamp_ns
+                                 : runners_[drone]->scans().back().stamp_ns;
+    SWARMLIO_RETURN_IF_ERROR(channels_[drone]->Send(stamp_ns, net::kBroadcastId, m));
     ++traffic_[drone].sent;
   }
   return Status::Ok();
@@ -112,16 +105,16 @@ Status SwarmReplay::Run(const ReplayOptions& options) {
       for (const net::ReceivedMessage& m : inbox) {
         ++traffic_[best].received;
         if (std::holds_alternative<net::EgoStateMessage>(m.message)) ++traffic_[best].ego_states;
+        runners_[best]->Deliver(m);
       }
     }
-    const size_t scans_before = runners_[best]->scans().size();
     const Status status = runners_[best]->Step();
     if (!status.ok()) {
       failed[best] = true;
       if (first_error.ok()) first_error = status;
     }
-    if (!channels_.empty() && runners_[best]->scans().size() > scans_before) {
-      const Status sent = Broadcast(best, scans_before);
+    if (!channels_.empty()) {
+      const Status sent = Broadcast(best);
       if (!sent.ok() && first_error.ok()) first_error = sent;
     }
     ++progress.records;

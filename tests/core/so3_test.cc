@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "test_utils/jacobian_check.h"
+#include "swarmlio/testing/jacobian_check.h"
 
 namespace swarmlio {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "factors/ego_state_manifold.h"
 #include "swarmlio/math/so3.h"
-#include "test_utils/jacobian_check.h"
+#include "swarmlio/testing/jacobian_check.h"
 
 namespace swarmlio {
 namespace {

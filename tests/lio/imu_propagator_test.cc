@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "swarmlio/math/so3.h"
+#include "swarmlio/testing/jacobian_check.h"
 #include "tests/test_utils/helix_trajectory.h"
-#include "tests/test_utils/jacobian_check.h"
 
 namespace swarmlio {
 namespace {

@@ -162,9 +162,7 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
         }
       }
     }
-    if (!options.single_agent) {
-      extra.push_back({"messages_received", static_cast<double>(run.traffic(i).received)});
-    }
+    extra.push_back({"messages_received", static_cast<double>(run.traffic(i).received)});
     m.drone = name;  // EvaluateDrone rewrites the whole struct
     m.extra = std::move(extra);
     metrics.push_back(std::move(m));
@@ -176,7 +174,7 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
       {"time_p95_ms", "time p95 [ms]", 2},
       {"realtime_factor", "real-time factor", 1},
       {"nees_position", "position NEES (3 expected)", 2}};
-  if (!options.single_agent) extra_columns.push_back({"messages_received", "msgs received", 0});
+  extra_columns.push_back({"messages_received", "msgs received", 0});
   eval::MetricsTable table;
   Status status = eval::MakeDroneMetricsTable(metrics, metric_options, extra_columns, &table);
   note(status);
@@ -192,7 +190,7 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
     note(eval::PlotErrorOverTime(errors, "APE translation [m]", plot,
                                  (dir / "ape_over_time.png").string()));
   }
-  if (!options.single_agent) note(WriteNetwork((dir / "network.csv").string(), run));
+  note(WriteNetwork((dir / "network.csv").string(), run));
   return first_error;
 }
 

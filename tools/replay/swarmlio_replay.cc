@@ -25,6 +25,7 @@
 
 #include "progress_bar.h"
 #include "report.h"
+#include "swarm_report.h"
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/eval/error_statistics.h"
 #include "swarmlio/replay/consistency.h"
@@ -187,7 +188,7 @@ int Main() {
 
   // Results are written even after an error: partial results are kept.
   for (int i = 0; i < run->num_drones(); ++i) PrintSummary(run->drone(i), wall_s);
-  if (!FLAGS_single_agent) {
+  {
     for (int i = 0; i < run->num_drones(); ++i) {
       const replay::DroneTraffic& t = run->traffic(i);
       std::printf("%s: sent %lld messages, received %lld (rejected %llu, duplicates %llu)\n",
@@ -204,6 +205,12 @@ int Main() {
   std::string markdown, problems;
   const Status report_status = WriteReport(*run, report, &markdown, &problems);
   std::printf("\n%s%s\n", FLAGS_single_agent ? "single-agent ablation\n" : "", markdown.c_str());
+  std::vector<PairMetrics> pairs;
+  std::string swarm_markdown;
+  const Status swarm_status =
+      WriteSwarmReport(*run, FLAGS_output_dir, FLAGS_save_maps, &pairs, &swarm_markdown);
+  if (run->num_drones() > 1) std::printf("teammates:\n%s\n", swarm_markdown.c_str());
+  if (!swarm_status.ok()) problems += swarm_status.message() + "\n";
   int exit_code = run_status.ok() && report_status.ok() ? 0 : 1;
   if (!problems.empty()) std::fprintf(stderr, "errors:\n%s", problems.c_str());
   rusage usage{};

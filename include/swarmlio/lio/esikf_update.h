@@ -1,16 +1,26 @@
 // EsikfUpdate: the iterated error-state Kalman update of one LiDAR scan
 // (paper Sec. III-D, FAST-LIO2's IEKF) written as undamped Gauss-Newton on a
 // Ceres problem with the ego / teammate parameter blocks, their manifolds, a
-// PriorFactor (x_hat, P_hat) and one PointToPlaneFactor for the whole scan.
-// The formulation, the Ceres configuration, the equivalence with the IEKF
-// equations and the measured cost are in docs/esikf.md.
+// PriorFactor (x_hat, P_hat) and the residual blocks of any number of
+// measurement models (measurement_model.h): point-to-plane, active and
+// passive mutual observations, ... The formulation, the Ceres configuration,
+// the equivalence with the IEKF equations and the measured cost are in
+// docs/esikf.md.
 //
-// Each outer iteration i: re-associate at x_i (callback), then one
-// Gauss-Newton step x_{i+1} = x_i (+) dx_i; stop when every rotation step is
-// below convergence_rotation_rad and every translation step below
-// convergence_translation_m, or after max_iterations. The posterior covariance
-// is (J^T J)^-1 at the final estimate, J the tangent Jacobian of all
-// residuals (prior included), in ErrorStateLayout order.
+// Each outer iteration i: every model re-linearizes at x_i (re-association
+// included), then one Gauss-Newton step x_{i+1} = x_i (+) dx_i; stop when
+// every rotation step is below convergence_rotation_rad and every translation
+// step below convergence_translation_m, or after max_iterations. The
+// posterior covariance is (J^T J)^-1 at the final estimate, J the tangent
+// Jacobian of all residual blocks (prior included), placed in
+// ErrorStateLayout order by the blocks each term names.
+//
+// Teammate subset (docs/esikf.md "Blocks left out"): an update may estimate
+// only some teammate blocks (those observed in this scan). The others keep
+// their mean and marginal covariance; their cross-covariance with the
+// estimated blocks becomes P_os P_ss^-1 P_ss^+ (the Schmidt-Kalman
+// "consider" update: exact covariance of an estimator that does not correct
+// them), so the cost grows with the teammates observed, not with the swarm.
 #pragma once
 
 #include <ceres/types.h>
@@ -22,6 +32,7 @@
 #include <vector>
 
 #include "factors/point_to_plane_factor.h"
+#include "swarmlio/lio/measurement_model.h"
 #include "swarmlio/config/option_fields.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/state/swarm_state.h"
@@ -65,7 +76,8 @@ struct EsikfUpdateResult {
   Eigen::MatrixXd covariance;       // posterior P, Dim x Dim (P_hat on failure)
   int iterations = 0;               // outer iterations run
   bool converged = false;           // step thresholds met before max_iterations
-  int num_correspondences = 0;      // at the last association
+  int num_correspondences = 0;      // at the last association (PlaneMeasurementModel)
+  int num_residual_blocks = 0;      // measurement residual blocks at the last iteration
   int num_rejected_steps = 0;       // steps Ceres refused because the cost rose
   double association_time_s = 0.0;  // total time in the callback [s]
   double solve_time_s = 0.0;        // total time in ceres::Solve [s]
@@ -90,10 +102,43 @@ class EsikfUpdate {
                             const SwarmState& x_start,
                             const PlaneAssociationFn& associate) const;
 
+  /// The general form: prior + the residual blocks of `models`, each
+  /// re-linearized at every iteration. `estimated_teammates`: the teammate
+  /// ids whose blocks this update estimates (nullptr: all in x_hat's layout;
+  /// ids absent from the layout are an error); see the file comment.
+  EsikfUpdateResult Run(const SwarmState& x_hat,
+                        const Eigen::MatrixXd& P_hat,
+                        const std::vector<MeasurementModel*>& models,
+                        const std::vector<int>* estimated_teammates = nullptr) const;
+  EsikfUpdateResult RunFrom(const SwarmState& x_hat,
+                            const Eigen::MatrixXd& P_hat,
+                            const SwarmState& x_start,
+                            const std::vector<MeasurementModel*>& models,
+                            const std::vector<int>* estimated_teammates = nullptr) const;
+
   const EsikfUpdateOptions& options() const { return options_; }
 
  private:
+  // All blocks of x_hat estimated.
+  EsikfUpdateResult RunAll(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
+                           const SwarmState& x_start,
+                           const std::vector<MeasurementModel*>& models) const;
   EsikfUpdateOptions options_;
+};
+
+/// The point-to-plane model: at every iteration the callback re-associates
+/// the scan at the estimate; one PointToPlaneFactor residual block (ego).
+class PlaneMeasurementModel final : public MeasurementModel {
+ public:
+  explicit PlaneMeasurementModel(PlaneAssociationFn associate);
+  const char* name() const override { return "point_to_plane"; }
+  Status Linearize(const SwarmState& x, std::vector<ResidualTerm>* terms) override;
+  const std::vector<PlaneCorrespondence>& correspondences() const { return correspondences_; }
+
+ private:
+  PlaneAssociationFn associate_;
+  std::vector<PlaneCorrespondence> correspondences_;
+  PointToPlaneFactor factor_;
 };
 
 }  // namespace swarmlio

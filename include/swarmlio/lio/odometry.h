@@ -6,8 +6,11 @@
 //   1. preprocess (filters, stride, range gate, voxel) -> points in b with times;
 //   2. propagate the state over the scan's IMU samples to t_e (eq. (2)-(3));
 //   3. undistort every point to the body frame at t_e;
-//   4. iterated update (EsikfUpdate: prior + point-to-plane on Ceres), the
-//      association re-evaluated at each iteration against the local map;
+//   3b. front end of the installed ScanStageHooks (scan_stage_hooks.h):
+//      teammate detection on the full scan, extra measurement models;
+//   4. iterated update (EsikfUpdate: prior + point-to-plane on Ceres + the
+//      hooks' models), every model re-linearized at each iteration;
+//   4b. points in the hooks' excluded regions (teammates) are removed;
 //   5. insert the registered points into the local map, move the map box.
 // The first scan after IMU initialization only builds the map.
 //
@@ -25,6 +28,7 @@
 
 #include "swarmlio/common/status.h"
 #include "swarmlio/lio/odometry_options.h"
+#include "swarmlio/lio/scan_stage_hooks.h"
 #include "swarmlio/sensors/lidar_options.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/swarm_state.h"
@@ -39,6 +43,7 @@ struct ScanTimings {
   double association_s = 0.0;  // kNN + plane fits, all iterations
   double solve_s = 0.0;        // ceres::Solve, all iterations
   double covariance_s = 0.0;   // posterior covariance
+  double front_end_s = 0.0;    // the hooks' front end (teammate detection, models)
   double map_update_s = 0.0;   // registration into G + map insertion + box move
   double total_s = 0.0;        // whole scan, including everything above
 };
@@ -54,6 +59,9 @@ struct ScanOutput {
   int num_raw_points = 0;         // points in the message
   int num_points = 0;             // after preprocessing
   int num_correspondences = 0;    // at the last iteration
+  int num_measurement_blocks = 0; // residual blocks of all models at the last iteration
+  int num_excluded_points = 0;    // kept out of the map (teammates)
+  std::string hook_error;         // the hooks' front-end error ("" otherwise)
   int iterations = 0;
   bool converged = false;
   /// Smallest eigenvalue of sum n n^T over the last correspondences, and
@@ -123,6 +131,9 @@ class Odometry {
   size_t map_size() const;
   size_t MapMemoryBytes() const;
 
+  /// Installs the scan-stage hooks (not owned; nullptr removes them).
+  void SetHooks(ScanStageHooks* hooks) { hooks_ = hooks; }
+
   const OdometryCounters& counters() const { return counters_; }
   const OdometryOptions& options() const { return options_; }
 
@@ -137,6 +148,7 @@ class Odometry {
   LidarOptions lidar_;
   std::unique_ptr<Impl> impl_;
   OdometryCounters counters_;
+  ScanStageHooks* hooks_ = nullptr;
   std::string init_error_ = "no IMU data yet";
 };
 

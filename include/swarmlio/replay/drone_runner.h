@@ -16,8 +16,23 @@
 #include "swarmlio/lio/odometry.h"
 #include "swarmlio/replay/manifest.h"
 #include "swarmlio/sensors/measurements.h"
+#include "swarmlio/swarm/drone_estimator.h"
 
 namespace swarmlio::replay {
+
+/// One teammate as an observer estimated it at one of its scan ends
+/// (compact: kept for every scan of every drone).
+struct TeammateRecord {
+  int drone_id = -1;  // index of the teammate in the manifest
+  GlobalExtrinsic T_Gi_Gj;
+  Eigen::Matrix<double, 6, 1> extrinsic_sigma2 = Eigen::Matrix<double, 6, 1>::Zero();  // cov diagonal
+  bool have_pose = false;
+  Eigen::Quaterniond q_Gi_bj = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d p_bj_in_Gi = Eigen::Vector3d::Zero();
+  bool seen = false;
+  int active_observations = 0;
+  int passive_observations = 0;
+};
 
 /// The per-scan record kept for evaluation and reports.
 struct ScanRecord {
@@ -35,10 +50,16 @@ struct ScanRecord {
   bool degenerate = false;
   size_t map_size = 0;
   lio::ScanTimings timings;
+  std::vector<TeammateRecord> teammates;  // every teammate in the state
+  int active_observations = 0;
+  int passive_observations = 0;
+  int rejected_observations = 0;
+  bool extrinsics_frozen = false;
 };
 
 /// The record kept of one estimator output.
 ScanRecord ToScanRecord(const lio::ScanOutput& output);
+ScanRecord ToScanRecord(const swarm::DroneOutput& output);
 
 struct DroneWarnings {
   int64_t count = 0;
@@ -48,7 +69,8 @@ struct DroneWarnings {
 class DroneRunner {
  public:
   /// Opens the bag and creates the estimator. Errors name the drone.
-  static Status Create(const DroneInput& input, std::unique_ptr<DroneRunner>* runner);
+  /// `drone_id`: the drone's index in the manifest (its swarm id).
+  static Status Create(const DroneInput& input, int drone_id, std::unique_ptr<DroneRunner>* runner);
 
   /// True while the bag has records left (after Prime()).
   bool has_next() const { return has_next_; }
@@ -60,11 +82,22 @@ class DroneRunner {
   Status Step();
   /// End of the log: processes the scans still waiting for IMU data.
   Status Finish();
+  /// A message from the network, arrived by the next record's stamp.
+  void Deliver(const net::ReceivedMessage& message);
+  /// Moves the messages the estimator produced since the last call.
+  void TakeMessages(std::vector<net::SwarmMessage>* messages);
+  /// Ablation switch: fuse mutual observations (true) or not.
+  void SetFusion(bool fuse);
+  /// Identifications so far.
+  const std::vector<swarm::IdentificationEvent>& identifications() const {
+    return identifications_;
+  }
 
   const DroneInput& input() const { return input_; }
   const std::vector<ScanRecord>& scans() const { return scans_; }
   const std::vector<PoseStamped>& bag_ground_truth() const { return ground_truth_; }
-  const lio::Odometry& odometry() const { return *odometry_; }
+  const lio::Odometry& odometry() const { return estimator_->odometry(); }
+  const swarm::DroneEstimator& estimator() const { return *estimator_; }
   const io::BagReader& reader() const { return *reader_; }
   const DroneWarnings& warnings() const { return warnings_; }
 
@@ -76,11 +109,12 @@ class DroneRunner {
 
   DroneInput input_;
   std::unique_ptr<io::BagReader> reader_;
-  std::unique_ptr<lio::Odometry> odometry_;
+  std::unique_ptr<swarm::DroneEstimator> estimator_;
   io::BagRecord next_;
   bool has_next_ = false;
   std::vector<ScanRecord> scans_;
-  std::vector<lio::ScanOutput> outputs_;  // scratch
+  std::vector<swarm::DroneOutput> outputs_;  // scratch
+  std::vector<swarm::IdentificationEvent> identifications_;
   std::vector<PoseStamped> ground_truth_;
   DroneWarnings warnings_;
 };

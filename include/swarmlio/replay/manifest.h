@@ -28,6 +28,8 @@
 #include "swarmlio/lio/odometry_options.h"
 #include "swarmlio/sensors/imu_options.h"
 #include "swarmlio/sensors/lidar_options.h"
+#include "swarmlio/swarm/swarm_options.h"
+#include "swarmlio/teammate/teammate_detector_options.h"
 
 namespace swarmlio::replay {
 
@@ -39,6 +41,8 @@ struct DroneInput {
   ImuOptions imu;
   io::BagReaderOptions bag;
   lio::OdometryOptions odometry;
+  teammate::TeammateDetectorOptions teammate;  // YAML `teammate:` of the drone entry
+  swarm::SwarmOptions swarm;                   // YAML `swarm:` of the drone entry
   /// Where the drone's global frame G lies in a common world frame W, only
   /// for drawing all drones in one top view (identity when unknown).
   Eigen::Matrix3d R_W_G = Eigen::Matrix3d::Identity();

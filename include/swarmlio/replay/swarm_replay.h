@@ -6,9 +6,11 @@
 // implement): after every scan a drone broadcasts its EgoStateMessage, and
 // before each of its records it polls what has arrived by that record's stamp.
 // The network's clock is the recorded stamps (drone clock offsets are not
-// modelled in delivery). Until the swarm layer exists the estimators do not
-// consume the messages; they are counted per drone. single_agent (the
-// ablation) sends nothing.
+// modelled in delivery). Every drone is a swarm::DroneEstimator: what arrives
+// is delivered to it, what it produces is broadcast. single_agent (the
+// ablation, the paper's FAST-LIO2 column) fuses no mutual observation;
+// messages still flow, so teammates are identified and reported through
+// the matched extrinsic (a loosely coupled baseline).
 #pragma once
 
 #include <cstdint>
@@ -41,7 +43,7 @@ struct ReplayOptions {
   /// Called every `progress_every_records` records (tool-side progress bar).
   std::function<void(const ReplayProgress&)> on_progress;
   int64_t progress_every_records = 2000;
-  /// Ablation: every drone runs alone, no message is sent.
+  /// Ablation: no mutual observation is fused (messages still flow).
   bool single_agent = false;
   /// The simulated network (latency, jitter, loss, reordering, duplication).
   net::NetworkOptions network;
@@ -79,7 +81,8 @@ class SwarmReplay {
   SwarmManifest manifest_;
   std::vector<std::unique_ptr<DroneRunner>> runners_;
   Status SetUpNetwork(const ReplayOptions& options);
-  Status Broadcast(int drone, size_t first_new_scan);
+  Status Broadcast(int drone);
+  std::vector<net::SwarmMessage> outbox_;
 
   std::unique_ptr<net::SimulatedNetwork> network_;
   net::PacketCodec codec_;

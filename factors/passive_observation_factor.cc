@@ -1,0 +1,105 @@
+#include "factors/passive_observation_factor.h"
+
+#include <Eigen/Cholesky>
+
+#include "factors/so3_manifold.h"
+#include "swarmlio/common/check.h"
+#include "swarmlio/math/so3.h"
+
+namespace swarmlio {
+namespace {
+
+using EgoJacobian = Eigen::Matrix<double, 3, EgoState::kAmbientSize, Eigen::RowMajor>;
+using ExtrinsicJacobian = Eigen::Matrix<double, 3, GlobalExtrinsic::kAmbientSize, Eigen::RowMajor>;
+
+Eigen::Matrix3d RotationOf(const Eigen::Quaterniond& q) {
+  return q.normalized().toRotationMatrix();
+}
+
+}  // namespace
+
+PassiveObservationFactor::PassiveObservationFactor(const Eigen::Vector3d& p_bi_in_bj,
+                                                   double dt,
+                                                   const Eigen::Matrix3d& R_Gj_bj,
+                                                   const Eigen::Vector3d& p_bj_in_Gj,
+                                                   const Eigen::Matrix3d& Sigma_obs,
+                                                   const Eigen::Matrix3d& Sigma_theta_bj,
+                                                   const Eigen::Matrix3d& Sigma_p_bj_in_Gj,
+                                                   const EgoState& ego_lin,
+                                                   const GlobalExtrinsic& extrinsic_lin)
+    : p_bi_in_bj_(p_bi_in_bj), dt_(dt), R_Gj_bj_(R_Gj_bj), p_bj_in_Gj_(p_bj_in_Gj) {
+  const Eigen::Matrix3d h0_hat = so3::Hat(Predict(ego_lin, extrinsic_lin));
+  const Eigen::Matrix3d S = Sigma_obs + h0_hat * Sigma_theta_bj * h0_hat.transpose() +
+                            R_Gj_bj_.transpose() * Sigma_p_bj_in_Gj * R_Gj_bj_;
+  covariance_ = 0.5 * (S + S.transpose());
+  const Eigen::LLT<Eigen::Matrix3d> llt(covariance_);
+  CHECK(covariance_.allFinite() && llt.info() == Eigen::Success)
+      << "passive observation covariance is not positive definite:\n"
+      << covariance_;
+  sqrt_information_ =
+      llt.matrixL().solve(Eigen::Matrix3d::Identity()).triangularView<Eigen::Lower>();
+}
+
+Eigen::Vector3d PassiveObservationFactor::EgoPositionInGj(const EgoState& ego,
+                                                          const GlobalExtrinsic& extrinsic) const {
+  return RotationOf(extrinsic.q_Gi_Gj).transpose() *
+         (ego.p_b_in_G + ego.v_b_in_G * dt_ - extrinsic.p_Gj_in_Gi);
+}
+
+Eigen::Vector3d PassiveObservationFactor::Predict(const EgoState& ego,
+                                                  const GlobalExtrinsic& extrinsic) const {
+  return R_Gj_bj_.transpose() * (EgoPositionInGj(ego, extrinsic) - p_bj_in_Gj_);
+}
+
+Eigen::Vector3d PassiveObservationFactor::Residual(const EgoState& ego,
+                                                   const GlobalExtrinsic& extrinsic) const {
+  return sqrt_information_ * (Predict(ego, extrinsic) - p_bi_in_bj_);
+}
+
+void PassiveObservationFactor::TangentJacobian(
+    const EgoState& ego,
+    const GlobalExtrinsic& extrinsic,
+    Eigen::Matrix<double, 3, EgoState::kTangentSize>* J_ego,
+    Eigen::Matrix<double, 3, GlobalExtrinsic::kTangentSize>* J_ext) const {
+  const Eigen::Matrix3d W_M =
+      sqrt_information_ * R_Gj_bj_.transpose() * RotationOf(extrinsic.q_Gi_Gj).transpose();
+  if (J_ego != nullptr) {
+    J_ego->setZero();
+    J_ego->block<3, 3>(0, ErrorStateLayout::kPosition.offset) = W_M;
+    J_ego->block<3, 3>(0, ErrorStateLayout::kVelocity.offset) = W_M * dt_;
+  }
+  if (J_ext != nullptr) {
+    J_ext->block<3, 3>(0, ErrorStateLayout::kTeammateRotationOffset) =
+        sqrt_information_ * R_Gj_bj_.transpose() * so3::Hat(EgoPositionInGj(ego, extrinsic));
+    J_ext->block<3, 3>(0, ErrorStateLayout::kTeammateTranslationOffset) = -W_M;
+  }
+}
+
+bool PassiveObservationFactor::Evaluate(double const* const* parameters,
+                                        double* residuals,
+                                        double** jacobians) const {
+  const EgoState ego = EgoState::FromParameters(parameters[0]);
+  const GlobalExtrinsic extrinsic = GlobalExtrinsic::FromParameters(parameters[1]);
+  Eigen::Map<Eigen::Vector3d> r(residuals);
+  r = Residual(ego, extrinsic);
+  if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) return true;
+
+  Eigen::Matrix<double, 3, EgoState::kTangentSize> J_ego;
+  Eigen::Matrix<double, 3, GlobalExtrinsic::kTangentSize> J_ext;
+  TangentJacobian(ego, extrinsic, jacobians[0] != nullptr ? &J_ego : nullptr,
+                  jacobians[1] != nullptr ? &J_ext : nullptr);
+  if (jacobians[0] != nullptr) {
+    // The attitude does not enter h: the quaternion columns are zero.
+    Eigen::Map<EgoJacobian> J(jacobians[0]);
+    J.leftCols<4>().setZero();
+    J.rightCols<15>() = J_ego.rightCols<15>();
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<ExtrinsicJacobian> J(jacobians[1]);
+    J.leftCols<4>() = SO3Manifold::LiftTangentJacobian<3>(J_ext.leftCols<3>(), parameters[1]);
+    J.rightCols<3>() = J_ext.rightCols<3>();
+  }
+  return true;
+}
+
+}  // namespace swarmlio

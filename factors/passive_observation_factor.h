@@ -1,0 +1,97 @@
+// PassiveObservationFactor: teammate j observed drone i (the ego) and
+// broadcast the detection (paper Sec. III-D, mutual observation, "passive"
+// case; docs/factors.md).
+//
+// Parameter blocks (ambient): ego (19) = [q_Gi_bi (x y z w) | p | v | b_g | b_a | g],
+// teammate extrinsic (7) = [q_Gi_Gj (x y z w) | p_Gj_in_Gi].
+// Constants: the measurement z = p_bi_in_bj (in b_j [m]) taken by j at time
+// t_j (already in i's clock), the teammate's broadcast pose at t_j
+// (R_Gj_bj, p_bj_in_Gj), and dt = t_j - t_k [s] where t_k is the time of the
+// ego state. The ego position is moved to t_j with its velocity (constant-
+// velocity time compensation; dt = 0 switches it off):
+//
+//   w = R_Gi_Gj^T (p_bi_in_Gi + v_bi_in_Gi dt - p_Gj_in_Gi)      (ego position in G_j)
+//   h = R_Gj_bj^T (w - p_bj_in_Gj)
+//   r = U^-1 (h - z),   S = U U^T (lower Cholesky),   |r|^2 = (h - z)^T S^-1 (h - z)
+//
+// Noise, evaluated ONCE at construction at the linearization point (the ego
+// state and extrinsic given to the constructor, through h0 = h(lin)):
+//   S = Sigma_obs + [h0]x Sigma_theta_bj [h0]x^T + R_Gj_bj^T Sigma_p_bj_in_Gj R_Gj_bj
+// with Sigma_obs the detection covariance in b_j, and Sigma_theta_bj,
+// Sigma_p_bj_in_Gj j's broadcast attitude (right perturbation
+// R_Gj_bj Exp(dtheta)) and position covariances; dh/d dtheta_bj = [h]x and
+// dh/d dp_bj = -R_Gj_bj^T.
+//
+// Tangent Jacobian of h (right perturbation R Exp(dtheta), p + dp; ego in
+// ErrorStateLayout order [dtheta dp dv dbg dba dg], extrinsic [dphi dp]),
+// with M = R_Gj_bj^T R_Gi_Gj^T:
+//   dh/d dtheta_ego = 0
+//   dh/d dp_ego     = M
+//   dh/d dv_ego     = M dt
+//   dh/d dphi_ext   = R_Gj_bj^T [w]x        ((R Exp(f))^T u = (I - [f]x) R^T u)
+//   dh/d dp_ext     = -M
+//   zero for b_g, b_a, g.
+// The residual Jacobian is U^-1 times these. Rotation columns are lifted to
+// the quaternions' ambient coordinates with SO3Manifold::LiftTangentJacobian.
+#pragma once
+
+#include <ceres/sized_cost_function.h>
+
+#include <Eigen/Core>
+
+#include "swarmlio/state/swarm_state.h"
+
+namespace swarmlio {
+
+class PassiveObservationFactor final
+    : public ceres::SizedCostFunction<3, EgoState::kAmbientSize, GlobalExtrinsic::kAmbientSize> {
+ public:
+  /// z = p_bi_in_bj [m]; dt = t_j - t_k [s]; (R_Gj_bj, p_bj_in_Gj) is j's pose
+  /// at t_j; Sigma_obs [m^2] in b_j, Sigma_theta_bj [rad^2], Sigma_p_bj_in_Gj
+  /// [m^2] in G_j. S is evaluated at h0 = h(ego_lin, extrinsic_lin). S must be
+  /// positive definite (CHECK); it is symmetrized first.
+  PassiveObservationFactor(const Eigen::Vector3d& p_bi_in_bj,
+                           double dt,
+                           const Eigen::Matrix3d& R_Gj_bj,
+                           const Eigen::Vector3d& p_bj_in_Gj,
+                           const Eigen::Matrix3d& Sigma_obs,
+                           const Eigen::Matrix3d& Sigma_theta_bj,
+                           const Eigen::Matrix3d& Sigma_p_bj_in_Gj,
+                           const EgoState& ego_lin,
+                           const GlobalExtrinsic& extrinsic_lin);
+
+  bool Evaluate(double const* const* parameters,
+                double* residuals,
+                double** jacobians) const override;
+
+  /// The prediction h (unwhitened) [m].
+  Eigen::Vector3d Predict(const EgoState& ego, const GlobalExtrinsic& extrinsic) const;
+  /// The whitened residual r = U^-1 (h - z).
+  Eigen::Vector3d Residual(const EgoState& ego, const GlobalExtrinsic& extrinsic) const;
+  /// Whitened tangent Jacobians dr/d dx_ego (3x18) and dr/d dx_ext (3x6).
+  /// Either pointer may be nullptr.
+  void TangentJacobian(const EgoState& ego,
+                       const GlobalExtrinsic& extrinsic,
+                       Eigen::Matrix<double, 3, EgoState::kTangentSize>* J_ego,
+                       Eigen::Matrix<double, 3, GlobalExtrinsic::kTangentSize>* J_ext) const;
+
+  const Eigen::Vector3d& measurement() const { return p_bi_in_bj_; }
+  double dt() const { return dt_; }
+  /// S, the innovation covariance of h - z [m^2].
+  const Eigen::Matrix3d& covariance() const { return covariance_; }
+  /// U^-1 (lower triangular), with S = U U^T.
+  const Eigen::Matrix3d& sqrt_information() const { return sqrt_information_; }
+
+ private:
+  // w = R_Gi_Gj^T (p_bi_in_Gi + v dt - p_Gj_in_Gi), the ego position at t_j in G_j.
+  Eigen::Vector3d EgoPositionInGj(const EgoState& ego, const GlobalExtrinsic& extrinsic) const;
+
+  Eigen::Vector3d p_bi_in_bj_;
+  double dt_;
+  Eigen::Matrix3d R_Gj_bj_;
+  Eigen::Vector3d p_bj_in_Gj_;
+  Eigen::Matrix3d covariance_;
+  Eigen::Matrix3d sqrt_information_;
+};
+
+}  // namespace swarmlio

@@ -1,0 +1,48 @@
+// MeasurementModel: one kind of measurement in the iterated update
+// (EsikfUpdate, docs/esikf.md "Measurement models"). The update calls
+// Linearize at every outer iteration with the current estimate; the model
+// re-associates if it needs to (point-to-plane re-finds its planes) and hands
+// back its residual blocks: Ceres cost functions it owns, each with the state
+// blocks it depends on. The update removes the previous iteration's blocks
+// and adds the new ones, so a model may change the number and shape of its
+// residuals from one iteration to the next.
+//
+// Conventions of a residual block: the residual is whitened (|r|^2 is the
+// Mahalanobis distance of the measurement), its parameter blocks are the ego
+// block (EgoState ambient, 19) and/or teammate blocks (GlobalExtrinsic
+// ambient, 7), in the order of `blocks`. The posterior covariance is formed
+// from the tangent Jacobians of all blocks, so a model need not provide
+// anything else.
+#pragma once
+
+#include <ceres/cost_function.h>
+
+#include <vector>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/state/swarm_state.h"
+
+namespace swarmlio {
+
+/// The ego block in ResidualTerm::blocks.
+inline constexpr int kEgoBlock = -1;
+
+/// One residual block a model contributes at one iteration.
+struct ResidualTerm {
+  const ceres::CostFunction* cost = nullptr;  // owned by the model, valid until its next Linearize
+  /// State blocks in the cost's parameter order: kEgoBlock or a teammate id.
+  std::vector<int> blocks;
+};
+
+class MeasurementModel {
+ public:
+  virtual ~MeasurementModel() = default;
+  /// Short name for diagnostics ("point_to_plane", "active_observation", ...).
+  virtual const char* name() const = 0;
+  /// Re-linearizes at `x` and appends this iteration's residual blocks to
+  /// `*terms` (none is fine: e.g. no plane found). Blocks may name only
+  /// teammates present in x's layout. A non-ok Status aborts the update.
+  virtual Status Linearize(const SwarmState& x, std::vector<ResidualTerm>* terms) = 0;
+};
+
+}  // namespace swarmlio

@@ -1,0 +1,142 @@
+// swarm::DroneEstimator: everything one drone runs (paper Fig. 2), the
+// component the offline replay, the live process, the ROS node and the tests
+// drive. It owns the LiDAR-inertial odometry (lio::Odometry), the teammate
+// detector / trackers / identification (teammate::TeammateDetector) and the
+// swarm state (T_Gi_Gj blocks in the odometry's state), and takes part in
+// the odometry's scan pipeline through lio::ScanStageHooks:
+//
+//   front end: undistort the full scan (with reflectivity), detect, track and
+//     identify teammates at the predicted pose; add a T_Gi_Gj block for each
+//     newly identified teammate, drop those lost for good; build the active
+//     observation factors (this scan's clusters) and the passive ones
+//     (received messages in which a teammate saw this drone);
+//   update: prior + point-to-plane + active + passive (EsikfUpdate), only the
+//     extrinsic blocks of teammates observed in this scan estimated;
+//   teammate points are kept out of the map; then the outputs: ego state,
+//     every teammate's state in G_i, and the EgoStateMessage to broadcast.
+//
+// Inputs: IMU samples, LiDAR scans (own clock), received messages (their
+// arrival time in the own clock). Outputs: PopOutputs, PopMessages. No I/O,
+// no clock reads, no threads inside. docs/swarm.md has the math and policies.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/lio/odometry.h"
+#include "swarmlio/net/message_channel.h"
+#include "swarmlio/net/messages.h"
+#include "swarmlio/sensors/lidar_options.h"
+#include "swarmlio/swarm/swarm_options.h"
+#include "swarmlio/teammate/teammate_detector.h"
+
+namespace swarmlio::swarm {
+
+struct DroneEstimatorOptions {
+  lio::OdometryOptions odometry;
+  teammate::TeammateDetectorOptions teammate;
+  SwarmOptions swarm;
+  std::string Validate() const;
+};
+
+/// One identified teammate's state in this drone's frame G_i at a scan end.
+struct TeammateEstimate {
+  int drone_id = -1;
+  GlobalExtrinsic T_Gi_Gj;                                           // from the state
+  Eigen::Matrix<double, 6, 6> extrinsic_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool have_pose = false;  // a recent enough broadcast state exists
+  Eigen::Quaterniond q_Gi_bj = Eigen::Quaterniond::Identity();  // j's body in G_i
+  Eigen::Vector3d p_bj_in_Gi = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_bj_in_Gi = Eigen::Vector3d::Zero();
+  bool seen = false;        // a LiDAR observation of j in this scan
+  int active_observations = 0;   // fused in this scan
+  int passive_observations = 0;  // fused in this scan
+};
+
+/// How a teammate was identified.
+struct IdentificationEvent {
+  int drone_id = -1;
+  int64_t stamp_ns = 0;       // own clock
+  std::string method;         // "trajectory_match"
+  double mean_residual_m = 0.0;
+  GlobalExtrinsic initial_T_Gi_Gj;
+};
+
+struct DroneOutput {
+  lio::ScanOutput ego;
+  std::vector<TeammateEstimate> teammates;  // every teammate in the state
+  std::vector<IdentificationEvent> identifications;  // in this scan
+  std::vector<int> removed_teammates;                // left the state in this scan
+  int active_observations = 0;    // fused
+  int passive_observations = 0;   // fused
+  int rejected_observations = 0;  // gated out or unusable (no recent message)
+  bool extrinsics_frozen = false; // degeneracy policy applied
+  int num_detector_points = 0;    // full-resolution points given to the detector
+};
+
+struct DroneEstimatorCounters {
+  int64_t messages_received = 0;
+  int64_t messages_ignored = 0;   // own, unknown type, non-finite, or stale
+  int64_t teammate_restarts = 0;  // session_start changed
+  int64_t identifications = 0;
+  int64_t teammates_removed = 0;
+  int64_t active_fused = 0;
+  int64_t passive_fused = 0;
+  int64_t observations_rejected = 0;
+  int64_t front_end_errors = 0;
+};
+
+class DroneEstimator : public lio::ScanStageHooks {
+ public:
+  static Status Create(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar,
+                       std::unique_ptr<DroneEstimator>* estimator);
+  ~DroneEstimator() override;
+
+  Status AddImu(const ImuSample& sample);
+  Status AddScan(const LidarScan& scan);
+  /// A message from the network (arrival time in this drone's clock). Bad
+  /// or own messages are counted and ignored (Ok).
+  Status AddMessage(const net::ReceivedMessage& message);
+  /// End of the log: processes the waiting scans.
+  Status Flush();
+  /// Ablation: fuse active and passive observations (per the options) or
+  /// none (teammates are still identified and reported).
+  void SetFusion(bool fuse) { fusion_enabled_ = fuse; }
+
+  void PopOutputs(std::vector<DroneOutput>* outputs);
+  /// Messages to broadcast, produced since the last call (one EgoStateMessage per scan).
+  void PopMessages(std::vector<net::SwarmMessage>* messages);
+
+  int self_id() const { return self_id_; }
+  const lio::Odometry& odometry() const { return *odometry_; }
+  const teammate::TeammateDetector& detector() const { return *detector_; }
+  const DroneEstimatorCounters& counters() const { return counters_; }
+  const DroneEstimatorOptions& options() const { return options_; }
+
+  // lio::ScanStageHooks
+  Status OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, Eigen::MatrixXd* P,
+                    lio::UpdateRequest* request) override;
+  void OnScanDone(const lio::ScanOutput& output, const SwarmState& x,
+                  const Eigen::MatrixXd& P) override;
+
+ private:
+  struct Impl;
+  DroneEstimator(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar);
+
+  int self_id_;
+  DroneEstimatorOptions options_;
+  LidarOptions lidar_;
+  std::unique_ptr<lio::Odometry> odometry_;
+  std::unique_ptr<teammate::TeammateDetector> detector_;
+  std::unique_ptr<Impl> impl_;
+  DroneEstimatorCounters counters_;
+  bool fusion_enabled_ = true;
+};
+
+}  // namespace swarmlio::swarm

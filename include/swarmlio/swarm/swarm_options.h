@@ -1,0 +1,94 @@
+// Options of the swarm layer of one drone (swarm::DroneEstimator): YAML
+// section `swarm` of a drone entry. docs/swarm.md explains each policy.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "swarmlio/config/option_fields.h"
+
+namespace swarmlio::swarm {
+
+/// What the update does with the extrinsic blocks when the last scan was
+/// LiDAR-degenerate (docs/swarm.md "Degeneracy").
+enum class DegeneracyPolicy {
+  kFreezeExtrinsics,  // Swarm-LIO2: hold T_Gi_Gj, trust the teammates (the observations
+                      // constrain the ego state only)
+  kEstimateAll,       // keep estimating T_Gi_Gj
+};
+
+}  // namespace swarmlio::swarm
+
+namespace swarmlio::config {
+template <>
+struct EnumTraits<swarm::DegeneracyPolicy> {
+  static constexpr std::array<std::pair<swarm::DegeneracyPolicy, const char*>, 2> kNames{{
+      {swarm::DegeneracyPolicy::kFreezeExtrinsics, "freeze_extrinsics"},
+      {swarm::DegeneracyPolicy::kEstimateAll, "estimate_all"},
+  }};
+};
+}  // namespace swarmlio::config
+
+namespace swarmlio::swarm {
+
+struct SwarmOptions {
+  /// Fuse active observations (I see j) in the update.
+  bool fuse_active = true;
+  /// Fuse passive observations (j saw me, from j's messages).
+  bool fuse_passive = true;
+  /// Passive observations shift the own position by v (t_j - t_k); active
+  /// ones predict j's broadcast state to the update time with its velocity
+  /// and angular rate. Off: both taken as if made at the update time.
+  bool time_compensation = true;
+  /// Teammate messages older than this at the update time are not used [s].
+  double max_message_age_s = 0.5;
+  /// A teammate neither seen nor heard for this long leaves the state [s].
+  double teammate_timeout_s = 10.0;
+  /// Initial T_Gi_Gj covariance from a trajectory match: 1-sigma translation
+  /// = max(this floor, translation_sigma_per_residual x mean residual) [m] ...
+  double init_translation_sigma_floor_m = 0.05;
+  double init_translation_sigma_per_residual = 3.0;
+  /// ... and rotation = max(floor, translation sigma / excitation extent) [rad].
+  double init_rotation_sigma_floor_rad = 1.0 * M_PI / 180.0;
+  /// Observations farther than this many sigma from the prediction are
+  /// rejected before the update (chi-square gate on 3 dof; 0 = off).
+  double gate_sigma = 5.0;
+  DegeneracyPolicy degeneracy_policy = DegeneracyPolicy::kFreezeExtrinsics;
+  /// Observations that involve a teammate whose last message says its scan
+  /// was degenerate are not fused here (its pose is not to be trusted; the
+  /// degenerate drone itself still fuses them).
+  bool skip_degenerate_teammates = true;
+  /// Radius of the ball around each tracked object kept out of the map [m].
+  double map_exclusion_radius_m = 0.5;
+
+  template <class V>
+  void VisitFields(V&& v) {
+    using config::FieldSpec;
+    v("fuse_active", fuse_active, FieldSpec::Doc("fuse active observations (I see teammate j)"));
+    v("fuse_passive", fuse_passive, FieldSpec::Doc("fuse passive observations (j saw me)"));
+    v("time_compensation", time_compensation,
+      FieldSpec::Doc("predict teammate states / shift passive observations to the update time"));
+    v("max_message_age_s", max_message_age_s,
+      FieldSpec::Positive("s", "teammate messages older than this are not used"));
+    v("teammate_timeout_s", teammate_timeout_s,
+      FieldSpec::Positive("s", "unseen and unheard this long: removed from the state"));
+    v("init_translation_sigma_floor_m", init_translation_sigma_floor_m,
+      FieldSpec::Positive("m", "smallest initial 1-sigma of p_Gj_in_Gi"));
+    v("init_translation_sigma_per_residual", init_translation_sigma_per_residual,
+      FieldSpec::Positive("", "initial 1-sigma of p_Gj_in_Gi per metre of match residual"));
+    v("init_rotation_sigma_floor_rad", init_rotation_sigma_floor_rad,
+      FieldSpec::Positive("rad", "smallest initial 1-sigma of R_Gi_Gj"));
+    v("gate_sigma", gate_sigma, FieldSpec::AtLeast(0.0, "", "Mahalanobis gate (0 = off)"));
+    v("degeneracy_policy", degeneracy_policy,
+      FieldSpec::Doc("freeze_extrinsics | estimate_all, after a degenerate scan"));
+    v("skip_degenerate_teammates", skip_degenerate_teammates,
+      FieldSpec::Doc("do not fuse observations involving a teammate that reports degeneracy"));
+    v("map_exclusion_radius_m", map_exclusion_radius_m,
+      FieldSpec::Positive("m", "points this close to a tracked object stay out of the map"));
+  }
+  std::string Validate() const { return config::ValidateFields(*this); }
+};
+
+}  // namespace swarmlio::swarm

@@ -1,0 +1,523 @@
+#include "swarmlio/swarm/drone_estimator.h"
+
+#include <ceres/cost_function.h>
+
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <cmath>
+#include <deque>
+#include <set>
+#include <utility>
+#include <variant>
+
+#include "factors/active_observation_factor.h"
+#include "factors/passive_observation_factor.h"
+#include "swarmlio/lio/undistortion.h"
+#include "swarmlio/math/so3.h"
+
+namespace swarmlio::swarm {
+namespace {
+
+double Seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
+
+// A two-block observation cost (ego, extrinsic) with the extrinsic held
+// constant: the degeneracy policy "freeze extrinsics" (docs/swarm.md).
+class FixedExtrinsicCost final : public ceres::CostFunction {
+ public:
+  FixedExtrinsicCost(std::unique_ptr<ceres::CostFunction> inner, const GlobalExtrinsic& T)
+      : inner_(std::move(inner)) {
+    T.ToParameters(extrinsic_.data());
+    set_num_residuals(inner_->num_residuals());
+    mutable_parameter_block_sizes()->push_back(EgoState::kAmbientSize);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* blocks[2] = {parameters[0], extrinsic_.data()};
+    double* inner_jacobians[2] = {jacobians != nullptr ? jacobians[0] : nullptr, nullptr};
+    return inner_->Evaluate(blocks, residuals, jacobians != nullptr ? inner_jacobians : nullptr);
+  }
+
+ private:
+  std::unique_ptr<ceres::CostFunction> inner_;
+  std::array<double, GlobalExtrinsic::kAmbientSize> extrinsic_{};
+};
+
+// The mutual observations of one scan: factors built at the front end; the
+// update re-evaluates them at every iteration (their residuals are exact
+// functions of the state; only the noise is fixed at the prediction).
+class MutualObservationModel final : public MeasurementModel {
+ public:
+  const char* name() const override { return "mutual_observation"; }
+  Status Linearize(const SwarmState&, std::vector<ResidualTerm>* terms) override {
+    for (size_t k = 0; k < costs_.size(); ++k) terms->push_back({costs_[k].get(), blocks_[k]});
+    return Status::Ok();
+  }
+  void Clear() {
+    costs_.clear();
+    blocks_.clear();
+  }
+  void Add(std::unique_ptr<ceres::CostFunction> cost, std::vector<int> blocks) {
+    costs_.push_back(std::move(cost));
+    blocks_.push_back(std::move(blocks));
+  }
+  bool empty() const { return costs_.empty(); }
+
+ private:
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
+  std::vector<std::vector<int>> blocks_;
+};
+
+bool Finite(const net::EgoStateMessage& m) {
+  return m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite() && m.v_bj_in_Gj.allFinite() &&
+         m.omega_bj_in_bj.allFinite() && m.cov_theta_Gj_bj.allFinite() &&
+         m.cov_p_bj_in_Gj.allFinite() && m.cov_v_bj_in_Gj.allFinite();
+}
+
+// A covariance from the network or the detector, made symmetric positive
+// definite (a floor of (1 mm)^2 on the diagonal).
+Eigen::Matrix3d Regularized(const Eigen::Matrix3d& C, double floor = 1e-6) {
+  Eigen::Matrix3d S = 0.5 * (C + C.transpose());
+  S.diagonal().array() += floor;
+  return S;
+}
+
+// Mahalanobis distance^2 of h - z under S.
+double Mahalanobis2(const Eigen::Vector3d& e, const Eigen::Matrix3d& S) {
+  return e.dot(S.ldlt().solve(e));
+}
+
+struct TeammateInfo {
+  bool have_message = false;
+  net::EgoStateMessage last;       // the newest received state
+  int64_t session_start_ns = 0;
+  int64_t last_heard_ns = 0;       // arrival of the newest message (own clock)
+  int64_t last_seen_ns = 0;        // last LiDAR observation (own clock)
+  bool restarted = false;          // session_start changed: drop its block
+};
+
+// A teammate's broadcast state predicted to time t (own clock).
+struct PredictedTeammate {
+  Eigen::Matrix3d R_Gj_bj;
+  Eigen::Vector3d p_bj_in_Gj;
+  Eigen::Vector3d v_bj_in_Gj;
+  Eigen::Matrix3d cov_p;
+  Eigen::Matrix3d cov_theta;
+};
+
+PredictedTeammate Predict(const net::EgoStateMessage& m, double dt) {
+  PredictedTeammate out;
+  const Eigen::Matrix3d R = m.q_Gj_bj.normalized().toRotationMatrix();
+  out.R_Gj_bj = R * so3::Exp(m.omega_bj_in_bj * dt);
+  out.p_bj_in_Gj = m.p_bj_in_Gj + m.v_bj_in_Gj * dt;
+  out.v_bj_in_Gj = m.v_bj_in_Gj;
+  out.cov_p = m.cov_p_bj_in_Gj + dt * dt * m.cov_v_bj_in_Gj;
+  out.cov_theta = m.cov_theta_Gj_bj;
+  return out;
+}
+
+struct PendingPassive {
+  int from = -1;
+  int64_t stamp_ns = 0;  // when j saw this drone (j's scan end, assumed own clock)
+  Eigen::Vector3d p_bi_in_bj = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
+  net::EgoStateMessage sender;  // j's state at that time
+};
+
+// What OnScanDone records, joined with the odometry's output afterwards.
+struct SwarmPart {
+  std::vector<TeammateEstimate> teammates;
+  std::vector<IdentificationEvent> identifications;
+  std::vector<int> removed;
+  int active = 0;
+  int passive = 0;
+  int rejected = 0;
+  int skipped_degenerate = 0;
+  bool frozen = false;
+  int detector_points = 0;
+};
+
+}  // namespace
+
+struct DroneEstimator::Impl {
+  std::map<int, TeammateInfo> teammates;
+  std::deque<PendingPassive> passive;
+  MutualObservationModel model;
+  std::vector<UndistortedPoint> undistorted;
+  std::vector<teammate::ScanPoint> points;
+  teammate::ScanResult detection;
+  Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();
+  // The scan in flight (between OnFrontEnd and OnScanDone).
+  SwarmPart part;
+  std::map<int, std::pair<int, int>> fused_by_teammate;  // active, passive
+  std::deque<SwarmPart> parts;
+  std::vector<lio::ScanOutput> odometry_outputs;
+  std::vector<DroneOutput> outputs;
+  std::vector<net::SwarmMessage> messages;
+};
+
+std::string DroneEstimatorOptions::Validate() const {
+  if (std::string e = odometry.Validate(); !e.empty()) return "odometry." + e;
+  if (std::string e = teammate.Validate(); !e.empty()) return "teammate." + e;
+  if (std::string e = swarm.Validate(); !e.empty()) return "swarm." + e;
+  return "";
+}
+
+DroneEstimator::DroneEstimator(int self_id, const DroneEstimatorOptions& options,
+                               const LidarOptions& lidar)
+    : self_id_(self_id), options_(options), lidar_(lidar), impl_(std::make_unique<Impl>()) {}
+
+DroneEstimator::~DroneEstimator() = default;
+
+Status DroneEstimator::Create(int self_id, const DroneEstimatorOptions& options,
+                              const LidarOptions& lidar,
+                              std::unique_ptr<DroneEstimator>* estimator) {
+  if (self_id < 0) return Status::InvalidArgument("drone id must be >= 0");
+  if (const std::string invalid = options.Validate(); !invalid.empty()) {
+    return Status::InvalidArgument("drone estimator options: " + invalid);
+  }
+  std::unique_ptr<DroneEstimator> out(new DroneEstimator(self_id, options, lidar));
+  SWARMLIO_RETURN_IF_ERROR(lio::Odometry::Create(options.odometry, lidar, &out->odometry_));
+  out->detector_ = std::make_unique<teammate::TeammateDetector>(self_id, options.teammate);
+  out->odometry_->SetHooks(out.get());
+  *estimator = std::move(out);
+  return Status::Ok();
+}
+
+namespace {
+
+// Joins the odometry's outputs with the swarm parts recorded by OnScanDone.
+void Collect(lio::Odometry* odometry, std::vector<lio::ScanOutput>* scratch,
+             std::deque<SwarmPart>* parts, std::vector<DroneOutput>* outputs) {
+  scratch->clear();
+  odometry->PopOutputs(scratch);
+  for (lio::ScanOutput& o : *scratch) {
+    DroneOutput d;
+    d.ego = std::move(o);
+    if (!parts->empty()) {
+      SwarmPart& p = parts->front();
+      d.teammates = std::move(p.teammates);
+      d.identifications = std::move(p.identifications);
+      d.removed_teammates = std::move(p.removed);
+      d.active_observations = p.active;
+      d.passive_observations = p.passive;
+      d.rejected_observations = p.rejected;
+      d.extrinsics_frozen = p.frozen;
+      d.num_detector_points = p.detector_points;
+      parts->pop_front();
+    }
+    outputs->push_back(std::move(d));
+  }
+}
+
+}  // namespace
+
+Status DroneEstimator::AddImu(const ImuSample& sample) {
+  if (sample.angular_velocity_rad_s.allFinite()) impl_->last_gyro = sample.angular_velocity_rad_s;
+  const Status status = odometry_->AddImu(sample);
+  Collect(odometry_.get(), &impl_->odometry_outputs, &impl_->parts, &impl_->outputs);
+  return status;
+}
+
+Status DroneEstimator::AddScan(const LidarScan& scan) {
+  const Status status = odometry_->AddScan(scan);
+  Collect(odometry_.get(), &impl_->odometry_outputs, &impl_->parts, &impl_->outputs);
+  return status;
+}
+
+Status DroneEstimator::Flush() {
+  const Status status = odometry_->Flush();
+  Collect(odometry_.get(), &impl_->odometry_outputs, &impl_->parts, &impl_->outputs);
+  return status;
+}
+
+void DroneEstimator::PopOutputs(std::vector<DroneOutput>* outputs) {
+  for (DroneOutput& o : impl_->outputs) outputs->push_back(std::move(o));
+  impl_->outputs.clear();
+}
+
+void DroneEstimator::PopMessages(std::vector<net::SwarmMessage>* messages) {
+  for (net::SwarmMessage& m : impl_->messages) messages->push_back(std::move(m));
+  impl_->messages.clear();
+}
+
+Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
+  ++counters_.messages_received;
+  const auto* m = std::get_if<net::EgoStateMessage>(&received.message);
+  if (m == nullptr || m->sender_id == self_id_ || m->sender_id < 0 || !Finite(*m)) {
+    ++counters_.messages_ignored;
+    return Status::Ok();
+  }
+  TeammateInfo& info = impl_->teammates[m->sender_id];
+  if (info.have_message && m->session_start_ns != info.session_start_ns) {
+    ++counters_.teammate_restarts;
+    info.restarted = true;
+    info.have_message = false;
+  }
+  if (info.have_message && m->stamp_ns <= info.last.stamp_ns) {
+    ++counters_.messages_ignored;  // older than what we have (reordered)
+  } else {
+    info.last = *m;
+    info.have_message = true;
+  }
+  info.session_start_ns = m->session_start_ns;
+  info.last_heard_ns = std::max(info.last_heard_ns, received.arrival_ns);
+
+  teammate::TeammateOdometry odometry;
+  odometry.stamp_s = Seconds(m->stamp_ns);
+  odometry.drone_id = m->sender_id;
+  odometry.p_bj_in_Gj = m->p_bj_in_Gj;
+  odometry.q_Gj_bj = m->q_Gj_bj.normalized();
+  odometry.v_bj_in_Gj = m->v_bj_in_Gj;
+  detector_->AddTeammateOdometry(odometry);
+
+  for (const net::TeammateObservation& o : m->observations) {
+    if (o.observed_id != self_id_ || !o.p_bk_in_bj.allFinite() || !o.cov_p_bk_in_bj.allFinite()) {
+      continue;
+    }
+    PendingPassive p;
+    p.from = m->sender_id;
+    p.stamp_ns = m->stamp_ns;
+    p.p_bi_in_bj = o.p_bk_in_bj;
+    p.cov = o.cov_p_bk_in_bj;
+    p.sender = *m;
+    p.sender.observations.clear();
+    impl_->passive.push_back(std::move(p));
+  }
+  return Status::Ok();
+}
+
+Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, Eigen::MatrixXd* P,
+                                  lio::UpdateRequest* request) {
+  Impl& im = *impl_;
+  im.part = SwarmPart();
+  im.fused_by_teammate.clear();
+  im.model.Clear();
+  const int64_t t_k = scan.end_stamp_ns;
+  const SwarmOptions& so = options_.swarm;
+
+  // 1. The full scan, motion-compensated to its end, with reflectivity.
+  SWARMLIO_RETURN_IF_ERROR(UndistortScan(*scan.raw, *scan.poses,
+                                         lidar_.QuaternionImuLidar().toRotationMatrix(),
+                                         lidar_.p_lidar_in_imu_m, &im.undistorted));
+  const double end_offset_s = Seconds(t_k - scan.raw->stamp_ns);
+  im.points.resize(im.undistorted.size());
+  for (size_t k = 0; k < im.undistorted.size(); ++k) {
+    const UndistortedPoint& u = im.undistorted[k];
+    teammate::ScanPoint& p = im.points[k];
+    p.p_in_b = u.p_in_b_end.cast<float>();
+    p.reflectivity = u.reflectivity;
+    p.time_offset_s = static_cast<float>(u.offset_time_s - end_offset_s);
+  }
+  im.part.detector_points = static_cast<int>(im.points.size());
+
+  // 2. Detection, tracking and identification at the predicted pose. The
+  // trackers read T_Gi_Gj from the state (its one owner).
+  for (int id : x->layout().teammate_ids()) {
+    detector_->SetGlobalExtrinsic(id, x->teammate(id).T_Gi_Gj());
+  }
+  Eigen::Isometry3d T_Gi_bi = Eigen::Isometry3d::Identity();
+  T_Gi_bi.linear() = x->ego.R_G_b();
+  T_Gi_bi.translation() = x->ego.p_b_in_G;
+  SWARMLIO_RETURN_IF_ERROR(detector_->ProcessScan(Seconds(t_k), T_Gi_bi, im.points, &im.detection));
+
+  // 3. State blocks: new teammates in, lost or restarted ones out.
+  for (const teammate::TeammateIdentification& id : im.detection.identifications) {
+    if (x->HasTeammate(id.drone_id)) continue;
+    GlobalExtrinsic T;
+    T.q_Gi_Gj = Eigen::Quaterniond(id.R_Gi_Gj).normalized();
+    T.p_Gj_in_Gi = id.p_Gj_in_Gi;
+    const double sigma_p = std::max(so.init_translation_sigma_floor_m,
+                                    so.init_translation_sigma_per_residual * id.mean_residual_m);
+    // The excitation flights span about a metre: a translation error sigma_p
+    // at the ends of a 1 m lever is a rotation error of sigma_p rad.
+    const double sigma_r = std::max(so.init_rotation_sigma_floor_rad, sigma_p / 1.0);
+    Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
+    C.diagonal().head<3>().setConstant(sigma_r * sigma_r);
+    C.diagonal().tail<3>().setConstant(sigma_p * sigma_p);
+    x->AddTeammate(id.drone_id, T);
+    AppendCovarianceBlock(C, P);
+    im.teammates[id.drone_id].last_seen_ns = t_k;
+    IdentificationEvent event;
+    event.drone_id = id.drone_id;
+    event.stamp_ns = t_k;
+    event.method = "trajectory_match";
+    event.mean_residual_m = id.mean_residual_m;
+    event.initial_T_Gi_Gj = T;
+    im.part.identifications.push_back(event);
+    ++counters_.identifications;
+  }
+  for (const teammate::TeammateObservation& o : im.detection.observations) {
+    im.teammates[o.drone_id].last_seen_ns = t_k;
+  }
+  const std::vector<int> ids = x->layout().teammate_ids();
+  for (int id : ids) {
+    TeammateInfo& info = im.teammates[id];
+    const int64_t last = std::max(info.last_seen_ns, info.last_heard_ns);
+    const bool lost = Seconds(t_k - last) > so.teammate_timeout_s;
+    if (!lost && !info.restarted) continue;
+    EraseCovarianceBlock(x->layout().TeammateBlock(id), P);
+    x->RemoveTeammate(id);
+    info.restarted = false;
+    im.part.removed.push_back(id);
+    ++counters_.teammates_removed;
+  }
+
+  // 4. Observation factors.
+  const bool frozen = so.degeneracy_policy == DegeneracyPolicy::kFreezeExtrinsics &&
+                      scan.previous_scan_degenerate;
+  im.part.frozen = frozen && x->layout().NumTeammates() > 0;
+  std::set<int> estimated;
+  const double gate2 = so.gate_sigma * so.gate_sigma;
+  const auto add = [&](std::unique_ptr<ceres::CostFunction> cost, int teammate_id,
+                       const Eigen::Vector3d& innovation, const Eigen::Matrix3d& S) {
+    if (so.gate_sigma > 0.0 && Mahalanobis2(innovation, S) > gate2) {
+      ++im.part.rejected;
+      ++counters_.observations_rejected;
+      return false;
+    }
+    if (frozen) {
+      im.model.Add(std::make_unique<FixedExtrinsicCost>(std::move(cost), x->teammate(teammate_id)),
+                   {kEgoBlock});
+    } else {
+      im.model.Add(std::move(cost), {kEgoBlock, teammate_id});
+      estimated.insert(teammate_id);
+    }
+    return true;
+  };
+  const Eigen::Matrix3d R_Gi_bi = x->ego.R_G_b();
+  const double max_age = so.max_message_age_s;
+  if (so.fuse_active && fusion_enabled_) {
+    for (const teammate::TeammateObservation& o : im.detection.observations) {
+      const auto it = im.teammates.find(o.drone_id);
+      if (!x->HasTeammate(o.drone_id) || it == im.teammates.end() || !it->second.have_message) {
+        continue;
+      }
+      const net::EgoStateMessage& m = it->second.last;
+      if (so.skip_degenerate_teammates && m.degenerated) {
+        ++im.part.skipped_degenerate;
+        continue;
+      }
+      const double age = Seconds(t_k - m.stamp_ns);
+      if (std::abs(age) > max_age) {
+        ++im.part.rejected;
+        ++counters_.observations_rejected;
+        continue;
+      }
+      const PredictedTeammate j = Predict(m, so.time_compensation ? age : 0.0);
+      const GlobalExtrinsic& T = x->teammate(o.drone_id);
+      auto factor = std::make_unique<ActiveObservationFactor>(
+          o.p_bj_in_bi, j.p_bj_in_Gj, Regularized(o.covariance_m2), Regularized(j.cov_p), R_Gi_bi,
+          T.R_Gi_Gj());
+      const Eigen::Vector3d e = factor->Predict(x->ego, T) - o.p_bj_in_bi;
+      const Eigen::Matrix3d S = factor->covariance();
+      if (add(std::move(factor), o.drone_id, e, S)) {
+        ++im.part.active;
+        ++im.fused_by_teammate[o.drone_id].first;
+        ++counters_.active_fused;
+      }
+    }
+  }
+  if (so.fuse_passive && fusion_enabled_) {
+    for (const PendingPassive& p : im.passive) {
+      if (!x->HasTeammate(p.from)) continue;
+      if (so.skip_degenerate_teammates && p.sender.degenerated) {
+        ++im.part.skipped_degenerate;
+        continue;
+      }
+      const double dt = Seconds(p.stamp_ns - t_k);
+      if (std::abs(dt) > max_age) {
+        ++im.part.rejected;
+        ++counters_.observations_rejected;
+        continue;
+      }
+      const GlobalExtrinsic& T = x->teammate(p.from);
+      auto factor = std::make_unique<PassiveObservationFactor>(
+          p.p_bi_in_bj, so.time_compensation ? dt : 0.0,
+          p.sender.q_Gj_bj.normalized().toRotationMatrix(), p.sender.p_bj_in_Gj,
+          Regularized(p.cov), Regularized(p.sender.cov_theta_Gj_bj, 1e-10),
+          Regularized(p.sender.cov_p_bj_in_Gj), x->ego, T);
+      const Eigen::Vector3d e = factor->Predict(x->ego, T) - p.p_bi_in_bj;
+      const Eigen::Matrix3d S = factor->covariance();
+      if (add(std::move(factor), p.from, e, S)) {
+        ++im.part.passive;
+        ++im.fused_by_teammate[p.from].second;
+        ++counters_.passive_fused;
+      }
+    }
+  }
+  im.passive.clear();  // each passive observation is used in one update at most
+
+  if (!im.model.empty()) request->models.push_back(&im.model);
+  request->estimated_teammates.assign(estimated.begin(), estimated.end());
+  // 5. Tracked objects stay out of the map.
+  const Eigen::Isometry3d T_bi_Gi = T_Gi_bi.inverse();
+  for (const teammate::TrackerState& s : im.detection.trackers) {
+    request->excluded.push_back({T_bi_Gi * s.p_in_Gi, so.map_exclusion_radius_m});
+  }
+  return Status::Ok();
+}
+
+void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState& x,
+                                const Eigen::MatrixXd& P) {
+  Impl& im = *impl_;
+  if (!output.hook_error.empty()) ++counters_.front_end_errors;
+  const int64_t t_k = output.stamp_ns;
+  for (int id : x.layout().teammate_ids()) {
+    TeammateEstimate e;
+    e.drone_id = id;
+    e.T_Gi_Gj = x.teammate(id);
+    const Segment block = x.layout().TeammateBlock(id);
+    e.extrinsic_covariance = P.block<6, 6>(block.offset, block.offset);
+    const TeammateInfo& info = im.teammates[id];
+    if (info.have_message &&
+        std::abs(Seconds(t_k - info.last.stamp_ns)) <= options_.swarm.max_message_age_s) {
+      const PredictedTeammate j = Predict(info.last, Seconds(t_k - info.last.stamp_ns));
+      const Eigen::Matrix3d R_Gi_Gj = e.T_Gi_Gj.R_Gi_Gj();
+      e.have_pose = true;
+      e.q_Gi_bj = Eigen::Quaterniond(R_Gi_Gj * j.R_Gj_bj).normalized();
+      e.p_bj_in_Gi = R_Gi_Gj * j.p_bj_in_Gj + e.T_Gi_Gj.p_Gj_in_Gi;
+      e.v_bj_in_Gi = R_Gi_Gj * j.v_bj_in_Gj;
+    }
+    e.seen = info.last_seen_ns == t_k;
+    const auto fused = im.fused_by_teammate.find(id);
+    if (fused != im.fused_by_teammate.end()) {
+      e.active_observations = fused->second.first;
+      e.passive_observations = fused->second.second;
+    }
+    im.part.teammates.push_back(e);
+  }
+  im.parts.push_back(std::move(im.part));
+  im.part = SwarmPart();
+
+  // The broadcast: this drone's state and what it saw of its teammates.
+  net::EgoStateMessage m;
+  m.sender_id = self_id_;
+  m.stamp_ns = t_k;
+  m.session_start_ns = odometry_->initialization().stamp_ns;
+  m.q_Gj_bj = x.ego.q_G_b.normalized();
+  m.p_bj_in_Gj = x.ego.p_b_in_G;
+  m.v_bj_in_Gj = x.ego.v_b_in_G;
+  m.omega_bj_in_bj = im.last_gyro - x.ego.gyro_bias;
+  const auto block = [&P](const Segment& s) {
+    return Eigen::Matrix3d(P.block<3, 3>(s.offset, s.offset));
+  };
+  m.cov_theta_Gj_bj = block(ErrorStateLayout::kRotation);
+  m.cov_p_bj_in_Gj = block(ErrorStateLayout::kPosition);
+  m.cov_v_bj_in_Gj = block(ErrorStateLayout::kVelocity);
+  m.degenerated = output.degenerate;
+  std::set<int> reported;
+  for (const teammate::TeammateObservation& o : im.detection.observations) {
+    if (static_cast<int>(m.observations.size()) >= net::EgoStateMessage::kMaxObservations) break;
+    if (o.drone_id == self_id_ || !reported.insert(o.drone_id).second) continue;
+    net::TeammateObservation n;
+    n.observed_id = o.drone_id;
+    n.p_bk_in_bj = o.p_bj_in_bi;
+    n.cov_p_bk_in_bj = o.covariance_m2;
+    m.observations.push_back(n);
+  }
+  im.detection.observations.clear();
+  if (m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite()) im.messages.push_back(m);
+}
+
+}  // namespace swarmlio::swarm

@@ -1,0 +1,296 @@
+// EsikfUpdate with several measurement models: point-to-plane, active and
+// passive mutual observations over teammate blocks (docs/swarm.md). One
+// Gauss-Newton step equals the closed-form iterated Kalman step with the
+// observation rows written out here from the paper's equations
+// (independently of the factors' code), covariance included; an update that
+// estimates only some teammate blocks equals the Schmidt-Kalman update
+// (zero gain for the blocks left out, Joseph-form covariance).
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "esikf_test_util.h"
+#include "factors/active_observation_factor.h"
+#include "factors/passive_observation_factor.h"
+#include "swarmlio/lio/esikf_update.h"
+#include "swarmlio/math/so3.h"
+
+namespace swarmlio {
+namespace {
+
+using esikf_test::Sampler;
+
+double MaxAbs(const Eigen::MatrixXd& m) { return m.cwiseAbs().maxCoeff(); }
+
+// A model with fixed residual blocks (the factors own their linearization
+// of the noise; the residuals are re-evaluated at every iteration).
+class FixedTerms final : public MeasurementModel {
+ public:
+  const char* name() const override { return "fixed"; }
+  Status Linearize(const SwarmState&, std::vector<ResidualTerm>* terms) override {
+    for (const ResidualTerm& t : terms_) terms->push_back(t);
+    return Status::Ok();
+  }
+  std::vector<ResidualTerm> terms_;
+};
+
+struct Active {
+  int j;
+  Eigen::Vector3d z, p_bj_in_Gj;
+  Eigen::Matrix3d S;  // innovation covariance (at x_hat)
+};
+struct Passive {
+  int j;
+  Eigen::Vector3d z, p_bj_in_Gj;
+  Eigen::Matrix3d R_Gj_bj, S;
+  double dt;
+};
+
+// Whitening W with W^T W = S^-1.
+Eigen::Matrix3d Whitening(const Eigen::Matrix3d& S) {
+  const Eigen::Matrix3d L = S.llt().matrixL();
+  return L.inverse();
+}
+
+// Rows of the active observation (paper eq. z_ao) at x, whitened.
+void ActiveRows(const SwarmState& x, const Active& a, Eigen::MatrixXd* H, Eigen::VectorXd* z) {
+  const Eigen::Matrix3d R_bi = x.ego.R_G_b();
+  const GlobalExtrinsic& T = x.teammate(a.j);
+  const Eigen::Vector3d h = R_bi.transpose() * (T.R_Gi_Gj() * a.p_bj_in_Gj + T.p_Gj_in_Gi -
+                                                x.ego.p_b_in_G);
+  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(3, x.Dim());
+  rows.block<3, 3>(0, 0) = so3::Hat(h);
+  rows.block<3, 3>(0, 3) = -R_bi.transpose();
+  const int o = x.layout().TeammateBlock(a.j).offset;
+  rows.block<3, 3>(0, o) = -R_bi.transpose() * T.R_Gi_Gj() * so3::Hat(a.p_bj_in_Gj);
+  rows.block<3, 3>(0, o + 3) = R_bi.transpose();
+  const Eigen::Matrix3d W = Whitening(a.S);
+  H->conservativeResize(H->rows() + 3, x.Dim());
+  H->bottomRows(3) = W * rows;
+  z->conservativeResize(z->size() + 3);
+  z->tail(3) = W * (h - a.z);
+}
+
+// Rows of the passive observation (paper eq. z_po, time-compensated).
+void PassiveRows(const SwarmState& x, const Passive& p, Eigen::MatrixXd* H, Eigen::VectorXd* z) {
+  const GlobalExtrinsic& T = x.teammate(p.j);
+  const Eigen::Vector3d w =
+      T.R_Gi_Gj().transpose() * (x.ego.p_b_in_G + x.ego.v_b_in_G * p.dt - T.p_Gj_in_Gi);
+  const Eigen::Vector3d h = p.R_Gj_bj.transpose() * (w - p.p_bj_in_Gj);
+  const Eigen::Matrix3d M = p.R_Gj_bj.transpose() * T.R_Gi_Gj().transpose();
+  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(3, x.Dim());
+  rows.block<3, 3>(0, 3) = M;
+  rows.block<3, 3>(0, 6) = M * p.dt;
+  const int o = x.layout().TeammateBlock(p.j).offset;
+  rows.block<3, 3>(0, o) = p.R_Gj_bj.transpose() * so3::Hat(w);
+  rows.block<3, 3>(0, o + 3) = -M;
+  const Eigen::Matrix3d W = Whitening(p.S);
+  H->conservativeResize(H->rows() + 3, x.Dim());
+  H->bottomRows(3) = W * rows;
+  z->conservativeResize(z->size() + 3);
+  z->tail(3) = W * (h - p.z);
+}
+
+struct Problem {
+  SwarmState x_hat, truth;
+  Eigen::MatrixXd P;
+  std::vector<PlaneCorrespondence> planes;
+  std::vector<Active> active;
+  std::vector<Passive> passive;
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+  FixedTerms terms;
+};
+
+Eigen::Matrix3d Spd(Sampler* s, double sigma) {
+  const Eigen::Matrix3d A = Eigen::Map<const Eigen::Matrix3d>(s->Gaussian(9, sigma).data());
+  return A * A.transpose() + sigma * sigma * Eigen::Matrix3d::Identity();
+}
+
+// x_hat with teammates 2, 7 (and 11 when `third`), observations of the
+// teammates in `observed`: two active ones and one passive one each.
+void MakeProblem(unsigned seed, bool third, const std::vector<int>& observed, Problem* pr) {
+  Sampler s(seed);
+  pr->x_hat = s.State(third ? 3 : 2);  // ids 2, 7, 12
+  const int n = pr->x_hat.Dim();
+  pr->P = s.Covariance(n, 0.1);
+  pr->truth = pr->x_hat.BoxPlus(s.Gaussian(n, 0.05));
+  pr->planes = s.Scan(pr->truth.ego, 4, 5, 0.05, 0.02);
+  const EgoState& e = pr->truth.ego;
+  for (int j : observed) {
+    const GlobalExtrinsic& T = pr->truth.teammate(j);
+    for (int k = 0; k < 2; ++k) {
+      Active a;
+      a.j = j;
+      const Eigen::Vector3d p_bj_in_Gi = e.p_b_in_G + s.Gaussian(3, 4.0);
+      a.p_bj_in_Gj = T.R_Gi_Gj().transpose() * (p_bj_in_Gi - T.p_Gj_in_Gi);
+      a.z = e.R_G_b().transpose() * (p_bj_in_Gi - e.p_b_in_G) + s.Gaussian(3, 0.02);
+      const Eigen::Matrix3d obs = Spd(&s, 0.03), cov_p = Spd(&s, 0.02);
+      auto f = std::make_unique<ActiveObservationFactor>(a.z, a.p_bj_in_Gj, obs, cov_p,
+                                                         pr->x_hat.ego.R_G_b(),
+                                                         pr->x_hat.teammate(j).R_Gi_Gj());
+      const Eigen::Matrix3d A = pr->x_hat.ego.R_G_b().transpose() * pr->x_hat.teammate(j).R_Gi_Gj();
+      a.S = obs + A * cov_p * A.transpose();
+      pr->terms.terms_.push_back({f.get(), {kEgoBlock, j}});
+      pr->costs.push_back(std::move(f));
+      pr->active.push_back(a);
+    }
+    Passive p;
+    p.j = j;
+    p.dt = -0.04;
+    p.R_Gj_bj = s.Rotation().toRotationMatrix();
+    const Eigen::Vector3d p_bi_at_tj = e.p_b_in_G + e.v_b_in_G * p.dt;
+    const Eigen::Vector3d p_bj_in_Gi = p_bi_at_tj + s.Gaussian(3, 4.0);
+    p.p_bj_in_Gj = T.R_Gi_Gj().transpose() * (p_bj_in_Gi - T.p_Gj_in_Gi);
+    p.z = p.R_Gj_bj.transpose() * (T.R_Gi_Gj().transpose() * (p_bi_at_tj - T.p_Gj_in_Gi) -
+                                   p.p_bj_in_Gj) + s.Gaussian(3, 0.02);
+    const Eigen::Matrix3d obs = Spd(&s, 0.03), cov_th = Spd(&s, 0.005), cov_p = Spd(&s, 0.02);
+    auto f = std::make_unique<PassiveObservationFactor>(p.z, p.dt, p.R_Gj_bj, p.p_bj_in_Gj, obs,
+                                                        cov_th, cov_p, pr->x_hat.ego,
+                                                        pr->x_hat.teammate(j));
+    const SwarmState& xh = pr->x_hat;
+    const Eigen::Vector3d w0 = xh.teammate(j).R_Gi_Gj().transpose() *
+                               (xh.ego.p_b_in_G + xh.ego.v_b_in_G * p.dt - xh.teammate(j).p_Gj_in_Gi);
+    const Eigen::Vector3d h0 = p.R_Gj_bj.transpose() * (w0 - p.p_bj_in_Gj);
+    p.S = obs + so3::Hat(h0) * cov_th * so3::Hat(h0).transpose() +
+          p.R_Gj_bj.transpose() * cov_p * p.R_Gj_bj;
+    pr->terms.terms_.push_back({f.get(), {kEgoBlock, j}});
+    pr->costs.push_back(std::move(f));
+    pr->passive.push_back(p);
+  }
+}
+
+void AllRows(const Problem& pr, const SwarmState& x, Eigen::MatrixXd* H, Eigen::VectorXd* z) {
+  esikf_test::PlaneRows(x, pr.planes, H, z);
+  for (const Active& a : pr.active) ActiveRows(x, a, H, z);
+  for (const Passive& p : pr.passive) PassiveRows(x, p, H, z);
+}
+
+EsikfUpdate OneStep() {
+  EsikfUpdateOptions o;
+  o.max_iterations = 1;
+  return EsikfUpdate(o);
+}
+
+TEST(EsikfMutualUpdate, OneStepEqualsTheIteratedKalmanStepWithBothObservationTypes) {
+  Problem pr;
+  MakeProblem(11, false, {2, 7}, &pr);
+  const std::vector<PlaneCorrespondence> planes = pr.planes;
+  double worst_dx = 0.0, worst_P = 0.0;
+  Sampler s(5);
+  for (double start_scale : {0.0, 0.03, 0.2}) {
+    SCOPED_TRACE(start_scale);
+    const SwarmState x_i = pr.x_hat.BoxPlus(s.Gaussian(pr.x_hat.Dim(), start_scale));
+    PlaneMeasurementModel plane_model(
+        [&planes](const SwarmState&, std::vector<PlaneCorrespondence>* out) {
+          *out = planes;
+          return Status::Ok();
+        });
+    const EsikfUpdateResult result =
+        OneStep().RunFrom(pr.x_hat, pr.P, x_i, {&plane_model, &pr.terms});
+    ASSERT_TRUE(result.status.ok()) << result.status.message();
+    ASSERT_EQ(result.num_rejected_steps, 0);
+    EXPECT_EQ(result.num_residual_blocks, 1 + 6);
+    Eigen::MatrixXd H;
+    Eigen::VectorXd z;
+    AllRows(pr, x_i, &H, &z);
+    const esikf_test::IekfStep step = esikf_test::ClosedFormIekfStep(pr.x_hat, pr.P, x_i, H, z);
+    AllRows(pr, result.state, &H, &z);
+    const esikf_test::IekfStep at_solution =
+        esikf_test::ClosedFormIekfStep(pr.x_hat, pr.P, result.state, H, z);
+    const double dx_err = MaxAbs(result.state.BoxMinus(x_i) - step.dx);
+    const double P_err = MaxAbs(result.covariance - at_solution.P);
+    EXPECT_LT(dx_err, 1e-9);
+    EXPECT_LT(P_err, 1e-9);
+    // The observations moved the teammate blocks (a real comparison).
+    EXPECT_GT(step.dx.segment<6>(18).norm(), 1e-3);
+    EXPECT_GT(step.dx.segment<6>(24).norm(), 1e-3);
+    worst_dx = std::max(worst_dx, dx_err);
+    worst_P = std::max(worst_P, P_err);
+  }
+  RecordProperty("max_abs_dx_diff", std::to_string(worst_dx));
+  RecordProperty("max_abs_P_diff", std::to_string(worst_P));
+}
+
+// Only teammate 7 observed; teammates 2 and 12 left out of the update.
+TEST(EsikfMutualUpdate, SubsetUpdateIsTheSchmidtKalmanUpdate) {
+  Problem pr;
+  MakeProblem(12, true, {7}, &pr);
+  const std::vector<PlaneCorrespondence> planes = pr.planes;
+  PlaneMeasurementModel plane_model([&planes](const SwarmState&, std::vector<PlaneCorrespondence>* out) {
+    *out = planes;
+    return Status::Ok();
+  });
+  const std::vector<int> estimated = {7};
+  const EsikfUpdateResult result =
+      OneStep().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &estimated);
+  ASSERT_TRUE(result.status.ok()) << result.status.message();
+
+  // Full-state rows, gain zeroed for the blocks left out, Joseph form. The
+  // step from the rows at x_hat; the covariance from the rows and the prior
+  // correction J at the solution (as the IEKF reports it, see the first test).
+  const int n = pr.x_hat.Dim();
+  std::vector<int> kept;
+  for (int k = 0; k < 18; ++k) kept.push_back(k);
+  for (int k = 0; k < 6; ++k) kept.push_back(pr.x_hat.layout().TeammateBlock(7).offset + k);
+  const auto schmidt = [&](const SwarmState& at, Eigen::VectorXd* dx, Eigen::MatrixXd* P_plus) {
+    Eigen::MatrixXd H;
+    Eigen::VectorXd z;
+    AllRows(pr, at, &H, &z);
+    const Eigen::VectorXd e = at.BoxMinus(pr.x_hat);
+    Eigen::MatrixXd J_inv = Eigen::MatrixXd::Identity(n, n);
+    J_inv.block<3, 3>(0, 0) = so3::RightJacobian(e.head<3>());
+    for (int id : pr.x_hat.layout().teammate_ids()) {
+      const int o = pr.x_hat.layout().TeammateRotation(id).offset;
+      J_inv.block<3, 3>(o, o) = so3::RightJacobian(e.segment<3>(o));
+    }
+    const Eigen::MatrixXd P_J = J_inv * pr.P * J_inv.transpose();
+    Eigen::MatrixXd Hs(H.rows(), kept.size());
+    Eigen::MatrixXd Pss(kept.size(), kept.size());
+    for (size_t c = 0; c < kept.size(); ++c) {
+      Hs.col(c) = H.col(kept[c]);
+      for (size_t r = 0; r < kept.size(); ++r) Pss(r, c) = P_J(kept[r], kept[c]);
+    }
+    const Eigen::MatrixXd S =
+        Hs * Pss * Hs.transpose() + Eigen::MatrixXd::Identity(H.rows(), H.rows());
+    const Eigen::MatrixXd Ks = Pss * Hs.transpose() * S.inverse();
+    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n, H.rows());
+    for (size_t r = 0; r < kept.size(); ++r) K.row(kept[r]) = Ks.row(r);
+    const Eigen::MatrixXd I_KH = Eigen::MatrixXd::Identity(n, n) - K * H;
+    *P_plus = I_KH * P_J * I_KH.transpose() + K * K.transpose();
+    *dx = -K * z;
+  };
+  Eigen::VectorXd dx, unused_dx;
+  Eigen::MatrixXd unused_P, P_plus;
+  schmidt(pr.x_hat, &dx, &unused_P);
+  schmidt(result.state, &unused_dx, &P_plus);
+  const double dx_err = MaxAbs(result.state.BoxMinus(pr.x_hat) - dx);
+  const double P_err = MaxAbs(result.covariance - P_plus);
+  EXPECT_LT(dx_err, 1e-9);
+  EXPECT_LT(P_err, 1e-9);
+  // The blocks left out kept their estimate and marginal covariance.
+  for (int id : {2, 12}) {
+    const Segment b = pr.x_hat.layout().TeammateBlock(id);
+    EXPECT_EQ(result.state.teammate(id).p_Gj_in_Gi, pr.x_hat.teammate(id).p_Gj_in_Gi);
+    EXPECT_EQ(MaxAbs(result.covariance.block(b.offset, b.offset, 6, 6) -
+                     pr.P.block(b.offset, b.offset, 6, 6)),
+              0.0);
+  }
+  // ... and their cross-covariance with the ego state changed.
+  const Segment b2 = pr.x_hat.layout().TeammateBlock(2);
+  EXPECT_GT(MaxAbs(result.covariance.block(0, b2.offset, 18, 6) - pr.P.block(0, b2.offset, 18, 6)),
+            1e-6);
+}
+
+TEST(EsikfMutualUpdate, ResidualBlockNamingAnAbsentTeammateIsAnError) {
+  Problem pr;
+  MakeProblem(13, false, {2}, &pr);
+  const std::vector<int> estimated = {7};  // 2 is observed but left out
+  const EsikfUpdateResult result = OneStep().Run(pr.x_hat, pr.P, {&pr.terms}, &estimated);
+  EXPECT_EQ(result.status.code(), Status::Code::kInvalidArgument);
+  const std::vector<int> unknown = {3};
+  EXPECT_EQ(OneStep().Run(pr.x_hat, pr.P, {&pr.terms}, &unknown).status.code(),
+            Status::Code::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace swarmlio

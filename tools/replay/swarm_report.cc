@@ -1,0 +1,192 @@
+#include "swarm_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+#include "swarmlio/eval/plots.h"
+#include "swarmlio/eval/trajectory_io.h"
+#include "swarmlio/io/pcd_writer.h"
+
+namespace swarmlio::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+Eigen::Isometry3d T_W_G(const replay::DroneInput& d) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = d.R_W_G;
+  T.translation() = d.p_G_in_W_m;
+  return T;
+}
+
+// Position of a trajectory at t by linear interpolation; false outside it.
+bool PositionAt(const eval::Trajectory& t, double stamp_s, Eigen::Vector3d* p) {
+  if (t.size() < 2 || stamp_s < t.stamps_s.front() || stamp_s > t.stamps_s.back()) return false;
+  const auto it = std::lower_bound(t.stamps_s.begin(), t.stamps_s.end(), stamp_s);
+  const size_t k = std::max<size_t>(1, static_cast<size_t>(it - t.stamps_s.begin()));
+  const double t0 = t.stamps_s[k - 1], t1 = t.stamps_s[k];
+  if (t1 - t0 > 0.5) return false;
+  const double a = t1 > t0 ? (stamp_s - t0) / (t1 - t0) : 0.0;
+  *p = (1.0 - a) * t.T_G_b[k - 1].translation() + a * t.T_G_b[k].translation();
+  return true;
+}
+
+double RotationDeg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI; }
+
+}  // namespace
+
+Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& output_dir,
+                        bool save_maps, std::vector<PairMetrics>* pairs, std::string* markdown) {
+  const fs::path dir(output_dir);
+  Status first_error;
+  auto note = [&](const Status& s) {
+    if (!s.ok() && first_error.ok()) first_error = s;
+  };
+  pairs->clear();
+  const int n = run.num_drones();
+  // Ground truth of every drone (its TUM file, in its own G).
+  std::vector<eval::Trajectory> truth(static_cast<size_t>(n));
+  std::vector<bool> has_truth(static_cast<size_t>(n), false);
+  for (int j = 0; j < n; ++j) {
+    const replay::DroneRunner& d = run.drone(j);
+    if (!d.input().ground_truth_path.empty()) {
+      has_truth[j] = eval::ReadTumTrajectory(d.input().ground_truth_path,
+                                             eval::TrajectoryReadOptions(), &truth[j])
+                         .ok();
+    } else if (!d.bag_ground_truth().empty()) {
+      truth[j] = eval::TrajectoryFromPoses(d.bag_ground_truth());
+      has_truth[j] = true;
+    }
+  }
+  std::vector<eval::ErrorSeries> extrinsic_series;
+  std::ofstream ident((dir / "identifications.csv").string());
+  ident << "observer,teammate,stamp_s,since_first_scan_s,method,mean_residual_m\n";
+  for (int i = 0; i < n; ++i) {
+    const replay::DroneRunner& d = run.drone(i);
+    const std::string& name = d.input().name;
+    const auto& scans = d.scans();
+    if (scans.empty()) continue;
+    const double t0 = StampSeconds(scans.front().stamp_ns);
+    for (const swarm::IdentificationEvent& e : d.identifications()) {
+      ident << name << "," << run.drone(e.drone_id).input().name << "," << std::fixed
+            << std::setprecision(6) << StampSeconds(e.stamp_ns) << ","
+            << StampSeconds(e.stamp_ns) - t0 << "," << e.method << "," << e.mean_residual_m << "\n";
+    }
+    // Extrinsics over time, and j's pose in G_i.
+    std::ofstream ext((dir / (name + "_extrinsics.csv")).string());
+    ext << "stamp_s,teammate,qx,qy,qz,qw,x,y,z,var_rx,var_ry,var_rz,var_x,var_y,var_z,active,"
+           "passive\n";
+    std::map<int, eval::Trajectory> teammate_tum;
+    std::map<int, PairMetrics> by_teammate;
+    for (const replay::ScanRecord& s : scans) {
+      const double t = StampSeconds(s.stamp_ns);
+      for (const replay::TeammateRecord& r : s.teammates) {
+        const Eigen::Quaterniond& q = r.T_Gi_Gj.q_Gi_Gj;
+        const Eigen::Vector3d& p = r.T_Gi_Gj.p_Gj_in_Gi;
+        ext << std::setprecision(9) << t << "," << run.drone(r.drone_id).input().name << ","
+            << q.x() << "," << q.y() << "," << q.z() << "," << q.w() << "," << p.x() << ","
+            << p.y() << "," << p.z();
+        for (int k = 0; k < 6; ++k) ext << "," << r.extrinsic_sigma2[k];
+        ext << "," << r.active_observations << "," << r.passive_observations << "\n";
+        PairMetrics& m = by_teammate[r.drone_id];
+        m.active_fused += r.active_observations;
+        m.passive_fused += r.passive_observations;
+        if (r.have_pose) {
+          Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+          T.linear() = r.q_Gi_bj.normalized().toRotationMatrix();
+          T.translation() = r.p_bj_in_Gi;
+          teammate_tum[r.drone_id].stamps_s.push_back(t);
+          teammate_tum[r.drone_id].T_G_b.push_back(T);
+        }
+        // Errors against the truth (simulated runs: the manifest's G frames).
+        const Eigen::Isometry3d T_true = T_W_G(d.input()).inverse() * T_W_G(run.drone(r.drone_id).input());
+        const double e_m = (p - T_true.translation()).norm();
+        const double e_deg = RotationDeg(T_true.linear().transpose() * r.T_Gi_Gj.R_Gi_Gj());
+        m.extrinsic_end_m = e_m;
+        m.extrinsic_end_deg = e_deg;
+        m.extrinsic_max_m = std::max(m.extrinsic_max_m, e_m);
+        m.extrinsic_max_deg = std::max(m.extrinsic_max_deg, e_deg);
+        Eigen::Vector3d p_true_in_Gj;
+        if (r.have_pose && has_truth[r.drone_id] && PositionAt(truth[r.drone_id], t, &p_true_in_Gj)) {
+          const double err = (r.p_bj_in_Gi - T_true * p_true_in_Gj).norm();
+          m.relative_rmse_m += err * err;
+          ++m.relative_samples;
+        }
+        eval::ErrorSeries* series = nullptr;
+        const std::string label = name + "->" + run.drone(r.drone_id).input().name;
+        for (auto& e : extrinsic_series) {
+          if (e.name == label) series = &e;
+        }
+        if (series == nullptr) {
+          extrinsic_series.push_back({label, {}, {}});
+          series = &extrinsic_series.back();
+        }
+        series->time_s.push_back(t - t0);
+        series->error.push_back(e_m);
+      }
+    }
+    for (auto& [j, traj] : teammate_tum) {
+      note(eval::WriteTumTrajectory(
+          (dir / (name + "_teammate_" + run.drone(j).input().name + "_tum.txt")).string(), traj));
+    }
+    for (int j = 0; j < n; ++j) {
+      if (j == i) continue;
+      PairMetrics m = by_teammate.count(j) ? by_teammate[j] : PairMetrics();
+      m.observer = name;
+      m.teammate = run.drone(j).input().name;
+      for (const swarm::IdentificationEvent& e : d.identifications()) {
+        if (e.drone_id == j && !m.identified) {
+          m.identified = true;
+          m.identification_s = StampSeconds(e.stamp_ns) - t0;
+        }
+      }
+      if (m.relative_samples > 0) m.relative_rmse_m = std::sqrt(m.relative_rmse_m / m.relative_samples);
+      pairs->push_back(m);
+    }
+  }
+  if (!extrinsic_series.empty()) {
+    eval::PlotOptions plot;
+    plot.title = run.manifest().name + ": T_Gi_Gj translation error over time";
+    note(eval::PlotErrorOverTime(extrinsic_series, "extrinsic error [m]", plot,
+                                 (dir / "extrinsic_error.png").string()));
+  }
+  // Merged map: every drone's map in G of the first drone, through drone 0's
+  // final T_G0_Gj estimates (drones it never identified are left out).
+  if (save_maps && n > 0 && !run.drone(0).scans().empty()) {
+    std::vector<Eigen::Vector3d> merged = run.drone(0).odometry().MapPoints();
+    for (const replay::TeammateRecord& r : run.drone(0).scans().back().teammates) {
+      const Eigen::Isometry3d T = r.T_Gi_Gj.T_Gi_Gj();
+      for (const Eigen::Vector3d& p : run.drone(r.drone_id).odometry().MapPoints()) {
+        merged.push_back(T * p);
+      }
+    }
+    note(io::WritePcd((dir / "merged_map.pcd").string(), merged));
+  }
+  std::ostringstream md;
+  md << "| observer | teammate | identified [s] | extrinsic end [m / deg] | extrinsic max [m / deg] "
+        "| teammate rel. RMSE [m] | active / passive fused |\n|---|---|---|---|---|---|---|\n";
+  md << std::fixed;
+  for (const PairMetrics& m : *pairs) {
+    md << "| " << m.observer << " | " << m.teammate << " | ";
+    if (!m.identified) {
+      md << "never | - | - | - | - |\n";
+      continue;
+    }
+    md << std::setprecision(1) << m.identification_s << " | " << std::setprecision(3)
+       << m.extrinsic_end_m << " / " << std::setprecision(2) << m.extrinsic_end_deg << " | "
+       << std::setprecision(3) << m.extrinsic_max_m << " / " << std::setprecision(2)
+       << m.extrinsic_max_deg << " | " << std::setprecision(3) << m.relative_rmse_m << " | "
+       << m.active_fused << " / " << m.passive_fused << " |\n";
+  }
+  *markdown = md.str();
+  std::ofstream mdfile((dir / "swarm.md").string());
+  mdfile << *markdown;
+  return first_error;
+}
+
+}  // namespace swarmlio::tools

@@ -1,0 +1,39 @@
+// Swarm outputs of a replay run (docs/replay.md "Swarm outputs"): per
+// observer i and teammate j, j's body pose in G_i (TUM), the T_Gi_Gj
+// estimates over time (CSV), identifications (CSV), a merged map of all
+// drones in G of the first drone, and the swarm metrics against the truth
+// (teammate relative-position error, extrinsic error, identification time),
+// plus a plot of the extrinsic error over time. Tool-side: writes files.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/replay/swarm_replay.h"
+
+namespace swarmlio::tools {
+
+/// One observer-teammate pair.
+struct PairMetrics {
+  std::string observer;
+  std::string teammate;
+  bool identified = false;
+  double identification_s = 0.0;   // since the observer's first scan [s]
+  double extrinsic_end_m = 0.0;    // |p error| at the last scan [m]
+  double extrinsic_end_deg = 0.0;  // rotation error at the last scan [deg]
+  double extrinsic_max_m = 0.0;    // max over the scans after identification
+  double extrinsic_max_deg = 0.0;
+  double relative_rmse_m = 0.0;    // j's position in G_i vs truth, RMSE [m]
+  int relative_samples = 0;
+  int active_fused = 0;
+  int passive_fused = 0;
+};
+
+/// Writes the swarm outputs into `output_dir`; `truth_known`: the manifest
+/// carries the true G frames (simulated runs) so extrinsic errors are
+/// computed. `*pairs` gets the per-pair metrics, `*markdown` a table.
+Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& output_dir,
+                        bool save_maps, std::vector<PairMetrics>* pairs, std::string* markdown);
+
+}  // namespace swarmlio::tools
