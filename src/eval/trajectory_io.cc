@@ -15,6 +15,10 @@ namespace {
 
 constexpr size_t kTumValues = 8;
 constexpr size_t kKittiValues = 12;
+// EuRoC: #timestamp [ns], p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w, q_RS_x, q_RS_y,
+// q_RS_z, then columns we ignore (velocity, biases in the ground truth).
+constexpr size_t kEurocValues = 8;
+constexpr double kNsPerS = 1e9;
 // A quaternion this close to zero has no defined rotation.
 constexpr double kMinQuaternionNorm = 1e-9;
 // Same tolerance as ValidateTrajectory (6-digit KITTI files).
@@ -37,6 +41,27 @@ bool Tokenize(std::string line, std::vector<std::string>* tokens) {
     if (end == std::string::npos) break;
     pos = line.find_first_not_of(" \t", end);
     if (pos == std::string::npos) break;
+  }
+  return true;
+}
+
+/// Splits a CSV line on ',' and trims spaces and tabs around each value.
+/// Returns false if the line is empty or starts with '#' (evo's rule).
+bool TokenizeCsv(std::string line, std::vector<std::string>* tokens) {
+  tokens->clear();
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t") == std::string::npos) {
+    return false;
+  }
+  size_t pos = 0;
+  while (true) {
+    const size_t end = line.find(',', pos);
+    std::string value = line.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+    const size_t first = value.find_first_not_of(" \t");
+    const size_t last = value.find_last_not_of(" \t");
+    tokens->push_back(first == std::string::npos ? "" : value.substr(first, last - first + 1));
+    if (end == std::string::npos) break;
+    pos = end + 1;
   }
   return true;
 }
@@ -99,13 +124,56 @@ Status ReadPoseLines(const std::string& path, Trajectory* trajectory, Trajectory
     }
     std::array<double, N> v{};
     const Status parsed = ParseNumbers(tokens, N, v.data());
-    if (!parsed.ok()) return Status::InvalidArgument(Where(path, line_number) + parsed.message());
+    if (!parsed.ok()) {
+      const std::string hint = line.find(',') != std::string::npos
+                                   ? " (comma-separated: EuRoC ground truth is read with the "
+                                     "euroc format)"
+                                   : "";
+      return Status::InvalidArgument(Where(path, line_number) + parsed.message() + hint);
+    }
     SWARMLIO_RETURN_IF_ERROR(on_line(line_number, tokens, v, &out, &counts));
   }
   SWARMLIO_RETURN_IF_ERROR(FinishReading(path, file, out));
   counts.pose_lines = static_cast<int>(out.size());
   *trajectory = std::move(out);
   if (stats != nullptr) *stats = counts;
+  return Status::Ok();
+}
+
+// Appends one stamped pose of a TUM or EuRoC file: the stamp must increase
+// (equal only with allow_duplicate_stamps), the quaternion must not be zero
+// and is normalised.
+Status AppendStampedPose(const std::string& path,
+                         int line_number,
+                         const std::string& stamp_text,
+                         double stamp_s,
+                         const Eigen::Vector3d& position,
+                         Eigen::Quaterniond q_G_b,
+                         const TrajectoryReadOptions& options,
+                         int* previous_line,
+                         Trajectory* out,
+                         TrajectoryReadStats* counts) {
+  if (out->has_stamps()) {
+    const double previous_s = out->stamps_s.back();
+    const bool equal = stamp_s == previous_s;
+    if (stamp_s < previous_s || (equal && !options.allow_duplicate_stamps)) {
+      return Status::InvalidArgument(
+          Where(path, line_number) + "stamp " + stamp_text + " does not increase (line " +
+          std::to_string(*previous_line) + ")" +
+          (equal ? "; equal stamps are accepted with allow_duplicate_stamps" : ""));
+    }
+    if (equal) ++counts->duplicate_stamps;
+  }
+  if (q_G_b.norm() < kMinQuaternionNorm) {
+    return Status::InvalidArgument(Where(path, line_number) + "zero quaternion");
+  }
+  q_G_b.normalize();
+  Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+  T_G_b.linear() = q_G_b.toRotationMatrix();
+  T_G_b.translation() = position;
+  out->stamps_s.push_back(stamp_s);
+  out->T_G_b.push_back(T_G_b);
+  *previous_line = line_number;
   return Status::Ok();
 }
 
@@ -128,6 +196,8 @@ bool TrajectoryFormatFromString(const std::string& text, TrajectoryFormat* forma
     *format = TrajectoryFormat::kTum;
   } else if (text == "kitti") {
     *format = TrajectoryFormat::kKitti;
+  } else if (text == "euroc") {
+    *format = TrajectoryFormat::kEuroc;
   } else {
     return false;
   }
@@ -142,34 +212,52 @@ Status ReadTumTrajectory(const std::string& path,
   return ReadPoseLines<kTumValues>(
       path, trajectory, stats,
       [&](int line_number, const std::vector<std::string>& tokens,
-          const std::array<double, kTumValues>& v, Trajectory* out,
-          TrajectoryReadStats* counts) {
-        const double stamp_s = v[0];
-        if (out->has_stamps()) {
-          const double previous_s = out->stamps_s.back();
-          const bool equal = stamp_s == previous_s;
-          if (stamp_s < previous_s || (equal && !options.allow_duplicate_stamps)) {
-            return Status::InvalidArgument(
-                Where(path, line_number) + "stamp " + tokens[0] + " does not increase (line " +
-                std::to_string(previous_line) + ")" +
-                (equal ? "; equal stamps are accepted with allow_duplicate_stamps" : ""));
-          }
-          if (equal) ++counts->duplicate_stamps;
-        }
+          const std::array<double, kTumValues>& v, Trajectory* out, TrajectoryReadStats* counts) {
         // File order is x y z w; Eigen's constructor takes w x y z.
-        Eigen::Quaterniond q_G_b(v[7], v[4], v[5], v[6]);
-        if (q_G_b.norm() < kMinQuaternionNorm) {
-          return Status::InvalidArgument(Where(path, line_number) + "zero quaternion");
-        }
-        q_G_b.normalize();
-        Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
-        T_G_b.linear() = q_G_b.toRotationMatrix();
-        T_G_b.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-        out->stamps_s.push_back(stamp_s);
-        out->T_G_b.push_back(T_G_b);
-        previous_line = line_number;
-        return Status::Ok();
+        return AppendStampedPose(
+            path, line_number, tokens[0], v[0], Eigen::Vector3d(v[1], v[2], v[3]),
+            Eigen::Quaterniond(v[7], v[4], v[5], v[6]), options, &previous_line, out, counts);
       });
+}
+
+Status ReadEurocTrajectory(const std::string& path,
+                           const TrajectoryReadOptions& options,
+                           Trajectory* trajectory,
+                           TrajectoryReadStats* stats) {
+  std::ifstream file;
+  SWARMLIO_RETURN_IF_ERROR(OpenForReading(path, &file));
+  Trajectory out;
+  TrajectoryReadStats counts;
+  std::string line;
+  std::vector<std::string> tokens;
+  int line_number = 0;
+  int previous_line = 0;
+  while (std::getline(file, line)) {
+    ++line_number;
+    if (!TokenizeCsv(line, &tokens)) {
+      ++counts.skipped_lines;
+      continue;
+    }
+    if (tokens.size() < kEurocValues) {
+      return Status::InvalidArgument(
+          Where(path, line_number) + "expected at least " + std::to_string(kEurocValues) +
+          " comma-separated values (timestamp [ns], p_RS_R_x y z [m], q_RS_w x y z), got " +
+          std::to_string(tokens.size()));
+    }
+    tokens.resize(kEurocValues);  // further columns are ignored
+    std::array<double, kEurocValues> v{};
+    const Status parsed = ParseNumbers(tokens, kEurocValues, v.data());
+    if (!parsed.ok()) return Status::InvalidArgument(Where(path, line_number) + parsed.message());
+    // evo: float64(stamp in ns) / 1e9, quaternion w x y z.
+    SWARMLIO_RETURN_IF_ERROR(AppendStampedPose(
+        path, line_number, tokens[0], v[0] / kNsPerS, Eigen::Vector3d(v[1], v[2], v[3]),
+        Eigen::Quaterniond(v[4], v[5], v[6], v[7]), options, &previous_line, &out, &counts));
+  }
+  SWARMLIO_RETURN_IF_ERROR(FinishReading(path, file, out));
+  counts.pose_lines = static_cast<int>(out.size());
+  *trajectory = std::move(out);
+  if (stats != nullptr) *stats = counts;
+  return Status::Ok();
 }
 
 Status ReadKittiTrajectory(const std::string& path,
@@ -206,6 +294,8 @@ Status ReadTrajectory(const std::string& path,
       return ReadTumTrajectory(path, options, trajectory, stats);
     case TrajectoryFormat::kKitti:
       return ReadKittiTrajectory(path, trajectory, stats);
+    case TrajectoryFormat::kEuroc:
+      return ReadEurocTrajectory(path, options, trajectory, stats);
   }
   return Status::InvalidArgument("unknown trajectory format");
 }

@@ -4,7 +4,6 @@
 #include <rosbag/exceptions.h>
 
 #include <filesystem>
-#include <map>
 #include <mutex>
 #include <system_error>
 
@@ -53,7 +52,10 @@ Status UnknownExceptionStatus(const std::string& path, const std::string& action
   return Status::Internal("bag '" + path + "': " + action + " failed: unknown exception");
 }
 
-Status OpenBagForReading(const std::string& path, bool verify_chunks, rosbag::Bag* bag) {
+Status OpenBagForReading(const std::string& path,
+                         bool verify_chunks,
+                         rosbag::Bag* bag,
+                         BagPrecheckResult* precheck_result) {
   RouteRosbagLogsToGlog();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -61,7 +63,7 @@ Status OpenBagForReading(const std::string& path, bool verify_chunks, rosbag::Ba
   }
   BagPrecheckOptions precheck;
   precheck.verify_chunk_records = verify_chunks;
-  SWARMLIO_RETURN_IF_ERROR(PrecheckBagFile(path, precheck));
+  SWARMLIO_RETURN_IF_ERROR(PrecheckBagFile(path, precheck, precheck_result));
   try {
     bag->open(path, rosbag::bagmode::Read);
   } catch (const std::exception& e) {
@@ -70,18 +72,6 @@ Status OpenBagForReading(const std::string& path, bool verify_chunks, rosbag::Ba
     return UnknownExceptionStatus(path, "open");
   }
   return Status::Ok();
-}
-
-std::string DescribeTopics(const std::vector<const rosbag::ConnectionInfo*>& connections) {
-  std::map<std::string, std::string> types;  // topic -> datatype
-  for (const rosbag::ConnectionInfo* c : connections) types.emplace(c->topic, c->datatype);
-  if (types.empty()) return "(none)";
-  std::string out;
-  for (const auto& [topic, datatype] : types) {
-    if (!out.empty()) out += ", ";
-    out += topic + " [" + datatype + "]";
-  }
-  return out;
 }
 
 }  // namespace swarmlio::io::internal

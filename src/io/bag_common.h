@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "src/io/bag_precheck.h"
 #include "swarmlio/common/status.h"
 
 namespace swarmlio::io::internal {
@@ -16,7 +17,11 @@ namespace swarmlio::io::internal {
 /// Opens `path` read-only after PrecheckBagFile (bag_precheck.h; chunk
 /// contents are verified when `verify_chunks`): NotFound if there is no such
 /// file, DataLoss or IoError with the path and the reason if it cannot be read.
-Status OpenBagForReading(const std::string& path, bool verify_chunks, rosbag::Bag* bag);
+/// `precheck` (may be null) tells whether a DataLoss came from a damaged index.
+Status OpenBagForReading(const std::string& path,
+                         bool verify_chunks,
+                         rosbag::Bag* bag,
+                         BagPrecheckResult* precheck = nullptr);
 
 /// Routes rosbag's console_bridge messages (e.g. about corrupt index
 /// entries) to glog VLOG(1) instead of stdout/stderr, unless the process
@@ -30,8 +35,5 @@ Status StatusFromException(const std::string& path,
 
 /// Status for a non-std exception thrown while doing `action` on `path`.
 Status UnknownExceptionStatus(const std::string& path, const std::string& action);
-
-/// "topic [datatype], ..." of the given connections, sorted, each topic once.
-std::string DescribeTopics(const std::vector<const rosbag::ConnectionInfo*>& connections);
 
 }  // namespace swarmlio::io::internal

@@ -13,14 +13,13 @@ std::string CheckTopic(const char* key, const std::string& topic, bool required)
 }  // namespace
 
 std::string BagReaderOptions::Validate() const {
+  // Empty or "auto" topics are found by type when the bag is opened.
   std::string error = config::ValidateFields(*this);
-  if (error.empty()) error = CheckTopic("imu_topic", imu_topic, true);
-  if (error.empty()) error = CheckTopic("lidar_topic", lidar_topic, true);
-  if (error.empty()) error = CheckTopic("ground_truth_topic", ground_truth_topic, false);
-  if (error.empty() && imu_topic == lidar_topic) {
+  if (error.empty() && !IsAutoTopic(imu_topic) && imu_topic == lidar_topic) {
     error = "lidar_topic: must differ from imu_topic '" + imu_topic + "'";
   }
-  if (error.empty() && (ground_truth_topic == imu_topic || ground_truth_topic == lidar_topic)) {
+  if (error.empty() && !IsAutoTopic(ground_truth_topic) &&
+      (ground_truth_topic == imu_topic || ground_truth_topic == lidar_topic)) {
     error = "ground_truth_topic: must differ from imu_topic and lidar_topic";
   }
   return error;

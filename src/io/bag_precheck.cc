@@ -1,153 +1,41 @@
 #include "src/io/bag_precheck.h"
 
-#include <bzlib.h>
-#include <roslz4/lz4s.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <map>
 #include <string>
 #include <system_error>
 #include <vector>
 
-#include "src/io/wire_reader.h"
+#include "src/io/bag_records.h"
 
 namespace swarmlio::io::internal {
 namespace {
 
-constexpr char kMagic[] = "#ROSBAG V2.0\n";
-constexpr size_t kMagicBytes = sizeof(kMagic) - 1;
-constexpr char kVersionPrefix[] = "#ROSBAG V";
-// Record header sizes we are willing to read (real ones are < 1 KiB).
-constexpr uint32_t kMaxRecordHeaderBytes = 1u << 20;
-// Record opcodes of the 2.0 format.
-constexpr uint8_t kOpMessageData = 0x02;
-constexpr uint8_t kOpFileHeader = 0x03;
-constexpr uint8_t kOpIndexData = 0x04;
-constexpr uint8_t kOpChunk = 0x05;
-constexpr uint8_t kOpChunkInfo = 0x06;
-constexpr uint8_t kOpConnection = 0x07;
-// Bytes of one index-data entry: u32 sec, u32 nsec, u32 offset.
-constexpr uint32_t kIndexEntryBytes = 12;
-// Smallest record: u32 header length + u32 data length.
-constexpr uint64_t kMinRecordBytes = 8;
-
-using HeaderFields = std::map<std::string, std::string>;
-
-Status ParseHeaderFields(const uint8_t* data, size_t size, HeaderFields* fields) {
-  fields->clear();
-  WireReader reader(data, size);
-  while (reader.remaining() > 0) {
-    std::string field;
-    SWARMLIO_RETURN_IF_ERROR(reader.ReadString("record header field", &field));
-    const size_t equals = field.find('=');
-    if (equals == std::string::npos) return Status::DataLoss("record header field without '='");
-    (*fields)[field.substr(0, equals)] = field.substr(equals + 1);
-  }
-  return Status::Ok();
-}
-
-// Reads a little-endian integer header field of exactly sizeof(UInt) bytes.
-template <class UInt>
-Status GetField(const HeaderFields& fields,
-                const std::string& name,
-                const std::string& where,
-                UInt* value) {
-  const auto it = fields.find(name);
-  if (it == fields.end() || it->second.size() != sizeof(UInt)) {
-    return Status::DataLoss(where + ": missing or malformed header field '" + name + "'");
-  }
-  *value = LoadLittleEndian<UInt>(reinterpret_cast<const uint8_t*>(it->second.data()));
-  return Status::Ok();
-}
-
-Status CheckOp(const HeaderFields& fields, uint8_t expected, const std::string& where) {
-  uint8_t op = 0;
-  SWARMLIO_RETURN_IF_ERROR(GetField(fields, "op", where, &op));
-  if (op != expected) {
-    return Status::DataLoss(where + ": record type " + std::to_string(op) + ", expected " +
-                            std::to_string(expected));
-  }
-  return Status::Ok();
-}
-
-// One record as stored: header fields and where its data lies.
-struct Record {
-  HeaderFields fields;
-  uint64_t data_offset = 0;
-  uint32_t data_bytes = 0;
-  uint64_t end() const { return data_offset + data_bytes; }
-};
-
-class BagFile {
- public:
-  BagFile(const std::string& path, uint64_t size) : file_(path, std::ios::binary), size_(size) {}
-
-  bool is_open() const { return file_.is_open(); }
-  uint64_t size() const { return size_; }
-
-  bool Read(uint64_t offset, size_t count, std::vector<uint8_t>* bytes) {
-    bytes->resize(count);
-    if (count == 0) return true;
-    file_.clear();
-    file_.seekg(static_cast<std::streamoff>(offset));
-    file_.read(reinterpret_cast<char*>(bytes->data()), static_cast<std::streamsize>(count));
-    return static_cast<size_t>(file_.gcount()) == count;
-  }
-
-  // Reads the record at `offset`, which must end by `limit`.
-  Status ReadRecord(uint64_t offset, uint64_t limit, const std::string& what, Record* record) {
-    const std::string where = what + " at offset " + std::to_string(offset);
-    if (offset + 4 > limit || !Read(offset, 4, &bytes_)) {
-      return Status::DataLoss(where + " is cut off (truncated or corrupt file of " +
-                              std::to_string(size_) + " bytes)");
-    }
-    const uint32_t header_bytes = LoadLittleEndian<uint32_t>(bytes_.data());
-    if (header_bytes > kMaxRecordHeaderBytes || offset + 4 + header_bytes + 4 > limit) {
-      return Status::DataLoss(where + " claims a " + std::to_string(header_bytes) +
-                              "-byte header, which does not fit (file has " +
-                              std::to_string(size_) + " bytes)");
-    }
-    if (!Read(offset + 4, header_bytes + 4, &bytes_)) {
-      return Status::IoError(where + ": read failed");
-    }
-    SWARMLIO_RETURN_IF_ERROR(
-        ParseHeaderFields(bytes_.data(), header_bytes, &record->fields).WithContext(where));
-    record->data_bytes = LoadLittleEndian<uint32_t>(bytes_.data() + header_bytes);
-    record->data_offset = offset + 4 + header_bytes + 4;
-    if (record->end() > limit) {
-      return Status::DataLoss(
-          where + " claims " + std::to_string(record->data_bytes) + " data bytes, but only " +
-          std::to_string(limit - record->data_offset) + " remain (truncated or corrupt file)");
-    }
-    return Status::Ok();
-  }
-
- private:
-  std::ifstream file_;
-  uint64_t size_;
-  std::vector<uint8_t> bytes_;
-};
-
 class BagChecker {
  public:
-  BagChecker(BagFile* file, const BagPrecheckOptions& options) : file_(file), options_(options) {}
+  BagChecker(BagFile* file, const BagPrecheckOptions& options, BagPrecheckResult* result)
+      : file_(file), options_(options), result_(result) {}
 
   Status Run() {
     std::vector<uint8_t> magic;
-    if (file_->size() < kMagicBytes || !file_->Read(0, kMagicBytes, &magic)) {
+    if (file_->size() < kBagMagicBytes || !file_->Read(0, kBagMagicBytes, &magic)) {
       return Status::DataLoss("not a ROS1 bag: file is too short (" +
                               std::to_string(file_->size()) + " bytes)");
     }
     const std::string line(magic.begin(), magic.end());
-    if (line != kMagic) {
-      if (line.rfind(kVersionPrefix, 0) == 0) return Status::Ok();  // rosbag's job
+    if (line != kBagMagic) {
+      if (line.rfind(kBagVersionPrefix, 0) == 0) return Status::Ok();  // rosbag's job
       return Status::DataLoss("not a ROS1 bag: no '#ROSBAG V2.0' line at the start");
     }
     SWARMLIO_RETURN_IF_ERROR(CheckFileHeader());
-    SWARMLIO_RETURN_IF_ERROR(CheckIndexSection());
+    // From here on the file header is intact: a missing or broken index
+    // leaves the records scannable (bag_recovery.h).
+    const Status index = CheckIndexSection();
+    if (!index.ok()) {
+      result_->index_damaged = true;
+      return index;
+    }
     std::sort(chunk_positions_.begin(), chunk_positions_.end());
     for (size_t i = 0; i < chunk_positions_.size(); ++i) {
       const uint64_t limit = i + 1 < chunk_positions_.size() ? chunk_positions_[i + 1] : index_pos_;
@@ -162,17 +50,19 @@ class BagChecker {
   Status CheckFileHeader() {
     Record record;
     const std::string where = "file header record";
-    SWARMLIO_RETURN_IF_ERROR(file_->ReadRecord(kMagicBytes, file_->size(), where, &record));
+    SWARMLIO_RETURN_IF_ERROR(file_->ReadRecord(kBagMagicBytes, file_->size(), where, &record));
     SWARMLIO_RETURN_IF_ERROR(CheckOp(record.fields, kOpFileHeader, where));
     SWARMLIO_RETURN_IF_ERROR(GetField(record.fields, "index_pos", where, &index_pos_));
     SWARMLIO_RETURN_IF_ERROR(GetField(record.fields, "conn_count", where, &conn_count_));
     SWARMLIO_RETURN_IF_ERROR(GetField(record.fields, "chunk_count", where, &chunk_count_));
     first_record_ = record.end();
     if (index_pos_ == 0) {
+      result_->index_damaged = true;
       return Status::DataLoss(
           "bag is not indexed (recording interrupted?); `rosbag reindex` can repair it");
     }
     if (index_pos_ < first_record_ || index_pos_ > file_->size()) {
+      result_->index_damaged = true;
       return Status::DataLoss("bag is truncated: its index starts at offset " +
                               std::to_string(index_pos_) + " but the file has " +
                               std::to_string(file_->size()) + " bytes");
@@ -235,24 +125,8 @@ class BagChecker {
     SWARMLIO_RETURN_IF_ERROR(GetField(chunk.fields, "size", "chunk record", &uncompressed_bytes));
     const auto compression = chunk.fields.find("compression");
     if (compression == chunk.fields.end()) return Status::DataLoss("no compression field");
-    // Compression ratios beyond these mean a corrupt size field (which rosbag
-    // would allocate).
-    const uint64_t compressed = chunk.data_bytes;
-    if (compression->second == "none") {
-      if (uncompressed_bytes != compressed) {
-        return Status::DataLoss("size " + std::to_string(uncompressed_bytes) + " != stored bytes " +
-                                std::to_string(compressed));
-      }
-    } else if (compression->second == "lz4" || compression->second == "bz2") {
-      const uint64_t max_ratio = compression->second == "lz4" ? 256 : 4096;
-      if (uncompressed_bytes > compressed * max_ratio + (1u << 16)) {
-        return Status::DataLoss("implausible uncompressed size " +
-                                std::to_string(uncompressed_bytes) + " for " +
-                                std::to_string(compressed) + " " + compression->second + " bytes");
-      }
-    } else {
-      return Status::DataLoss("unknown compression '" + compression->second + "'");
-    }
+    SWARMLIO_RETURN_IF_ERROR(
+        CheckChunkSizes(compression->second, chunk.data_bytes, uncompressed_bytes));
 
     // Index data records: message offsets inside the uncompressed chunk.
     offsets_.clear();
@@ -291,30 +165,7 @@ class BagChecker {
     if (!file_->Read(chunk.data_offset, chunk.data_bytes, &bytes_)) {
       return Status::IoError("chunk data: read failed");
     }
-    if (compression == "none") {
-      chunk_.swap(bytes_);
-      return Status::Ok();
-    }
-    chunk_.resize(size);
-    unsigned int out_bytes = size;
-    char* in = reinterpret_cast<char*>(bytes_.data());
-    char* out = reinterpret_cast<char*>(chunk_.data());
-    const unsigned int in_bytes = static_cast<unsigned int>(bytes_.size());
-    int result = 0;
-    bool ok = false;
-    if (compression == "lz4") {
-      result = roslz4_buffToBuffDecompress(in, in_bytes, out, &out_bytes);
-      ok = result == ROSLZ4_OK;
-    } else {
-      result = BZ2_bzBuffToBuffDecompress(out, &out_bytes, in, in_bytes, 0, 0);
-      ok = result == BZ_OK;
-    }
-    if (!ok || out_bytes != size) {
-      return Status::DataLoss(compression + " chunk does not decompress to its " +
-                              std::to_string(size) + " bytes (error " + std::to_string(result) +
-                              ")");
-    }
-    return Status::Ok();
+    return DecompressChunk(compression, &bytes_, size, &chunk_);
   }
 
   Status CheckMessageRecord(uint32_t offset) {
@@ -339,6 +190,7 @@ class BagChecker {
 
   BagFile* file_;
   BagPrecheckOptions options_;
+  BagPrecheckResult* result_;
   uint64_t index_pos_ = 0;
   uint32_t conn_count_ = 0;
   uint32_t chunk_count_ = 0;
@@ -352,13 +204,18 @@ class BagChecker {
 
 }  // namespace
 
-Status PrecheckBagFile(const std::string& path, const BagPrecheckOptions& options) {
+Status PrecheckBagFile(const std::string& path,
+                       const BagPrecheckOptions& options,
+                       BagPrecheckResult* result) {
+  BagPrecheckResult unused;
+  if (result == nullptr) result = &unused;
+  *result = BagPrecheckResult();
   std::error_code ec;
   const uint64_t size = std::filesystem::file_size(path, ec);
   if (ec) return Status::IoError("bag '" + path + "': cannot get the file size: " + ec.message());
   BagFile file(path, size);
   if (!file.is_open()) return Status::IoError("bag '" + path + "': cannot open the file");
-  return BagChecker(&file, options).Run().WithContext("bag '" + path + "'");
+  return BagChecker(&file, options, result).Run().WithContext("bag '" + path + "'");
 }
 
 }  // namespace swarmlio::io::internal

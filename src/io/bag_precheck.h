@@ -22,10 +22,20 @@ struct BagPrecheckOptions {
   bool verify_chunk_records = false;
 };
 
+struct BagPrecheckResult {
+  /// Set with a DataLoss error when the file header is intact but the index
+  /// is not usable: not indexed (index_pos = 0, the recorder died), index
+  /// beyond the end of the file (truncated), or an index section that is
+  /// cut off or corrupt. The records can then be scanned (bag_recovery.h).
+  bool index_damaged = false;
+};
+
 /// Ok if `path` looks like a complete, consistent ROS1 2.0 bag; DataLoss (or
 /// IoError if it cannot be read) with the path and the problem otherwise.
 /// Files that start with another "#ROSBAG V" version are passed through
-/// unchecked (rosbag handles them).
-Status PrecheckBagFile(const std::string& path, const BagPrecheckOptions& options);
+/// unchecked (rosbag handles them). `result` may be null.
+Status PrecheckBagFile(const std::string& path,
+                       const BagPrecheckOptions& options,
+                       BagPrecheckResult* result = nullptr);
 
 }  // namespace swarmlio::io::internal

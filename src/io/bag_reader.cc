@@ -1,27 +1,25 @@
 #include "swarmlio/io/bag_reader.h"
 
 #include <geometry_msgs/PoseStamped.h>
-#include <ros/serialization.h>
-#include <rosbag/bag.h>
-#include <rosbag/query.h>
-#include <rosbag/view.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include <array>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "src/io/bag_common.h"
+#include "src/io/bag_source.h"
 #include "src/io/custom_msg.h"
 #include "src/io/custom_msg_codec.h"
 #include "src/io/imu_codec.h"
+#include "src/io/odometry_msg.h"
+#include "src/io/point_time_check.h"
 #include "src/io/pointcloud2_codec.h"
 #include "src/io/pose_codec.h"
-#include "src/io/ros_time.h"
 #include "swarmlio/common/check.h"
 
 namespace swarmlio::io {
@@ -35,6 +33,8 @@ constexpr char kPoseStampedType[] = "geometry_msgs/PoseStamped";
 // The Livox drivers 1 and 2 use the same CustomMsg layout (and MD5).
 constexpr std::array<const char*, 2> kCustomMsgTypes = {"livox_ros_driver/CustomMsg",
                                                         "livox_ros_driver2/CustomMsg"};
+// LiDAR messages whose bag times give the scan period.
+constexpr size_t kScanPeriodSamples = 1001;
 
 enum class StreamKind { kImu, kLidar, kGroundTruth };
 
@@ -48,6 +48,38 @@ const char* OptionKey(StreamKind kind) {
       return "ground_truth_topic";
   }
   return "?";
+}
+
+// The message types a stream accepts, for messages.
+const char* AcceptedTypes(StreamKind kind) {
+  switch (kind) {
+    case StreamKind::kImu:
+      return "sensor_msgs/Imu";
+    case StreamKind::kLidar:
+      return "sensor_msgs/PointCloud2 or livox_ros_driver(2)/CustomMsg";
+    case StreamKind::kGroundTruth:
+      return "geometry_msgs/PoseStamped or nav_msgs/Odometry";
+  }
+  return "?";
+}
+
+bool IsCustomMsgType(const std::string& datatype) {
+  for (const char* custom : kCustomMsgTypes) {
+    if (datatype == custom) return true;
+  }
+  return false;
+}
+
+bool TypeMatches(StreamKind kind, const std::string& datatype) {
+  switch (kind) {
+    case StreamKind::kImu:
+      return datatype == kImuType;
+    case StreamKind::kLidar:
+      return datatype == kPointCloud2Type || IsCustomMsgType(datatype);
+    case StreamKind::kGroundTruth:
+      return datatype == kPoseStampedType || datatype == internal::kNavOdometryDataType;
+  }
+  return false;
 }
 
 bool AllFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
@@ -90,93 +122,152 @@ class BagReader::Impl {
   const BagReaderOptions& options() const { return options_; }
   const std::string& path() const { return path_; }
   LidarMessageType lidar_message_type() const { return lidar_type_; }
-  bool has_ground_truth() const { return streams_.size() == 3; }
-  int64_t start_time_ns() const { return start_time_ns_; }
-  int64_t end_time_ns() const { return end_time_ns_; }
+  GroundTruthMessageType ground_truth_message_type() const { return ground_truth_type_; }
+  bool has_ground_truth() const { return !ground_truth_topic_.empty(); }
+  const std::string& imu_topic() const { return imu_topic_; }
+  const std::string& lidar_topic() const { return lidar_topic_; }
+  const std::string& ground_truth_topic() const { return ground_truth_topic_; }
+  double scan_period_s() const { return scan_period_s_; }
+  int64_t start_time_ns() const { return source_->start_time_ns(); }
+  int64_t end_time_ns() const { return source_->end_time_ns(); }
 
  private:
-  // One topic streamed through its own index view, with one decoded record
-  // of lookahead for the stamp-ordered merge.
+  // One topic streamed in bag-time order, with one decoded record of
+  // lookahead for the stamp-ordered merge.
   struct TopicStream {
     StreamKind kind = StreamKind::kImu;
     std::string topic;
-    std::unique_ptr<rosbag::View> view;
-    rosbag::View::iterator it;
-    rosbag::View::iterator end;
+    std::unique_ptr<internal::TopicMessageStream> messages;
     bool exhausted = false;
     std::optional<BagRecord> pending;
     bool pending_without_point_time = false;
     bool has_last_stamp = false;
     int64_t last_stamp_ns = 0;
-    int64_t message_index = 0;  // index within the topic of the message at `it`
+    int64_t message_index = -1;  // index within the topic of the last message read
   };
 
-  Status CheckTopic(const std::vector<const rosbag::ConnectionInfo*>& connections,
-                    StreamKind kind,
-                    const std::string& topic,
-                    bool required,
-                    bool* found);
+  // Finds the topic of `kind`: the configured one when the bag has it, else
+  // the only topic of a matching type (see BagReaderOptions). "" = none
+  // (ground truth only).
+  Status ResolveTopic(StreamKind kind, const std::string& configured, std::string* resolved);
+  // Checks every connection of `topic` for a supported type and MD5, and
+  // sets lidar_type_ / ground_truth_type_.
+  Status CheckTopic(StreamKind kind, const std::string& topic);
   Status AddStream(StreamKind kind, const std::string& topic);
   Status Fill(TopicStream* stream);
-  // Decodes and checks the message at stream->it; sets stream->pending when
-  // the record is delivered, leaves it empty when skipped.
-  Status Consume(TopicStream* stream, const rosbag::MessageInstance& message);
+  // Decodes and checks one message; sets stream->pending when the record is
+  // delivered, leaves it empty when skipped.
+  Status Consume(TopicStream* stream, const internal::SourceMessage& message);
   Status Malformed(const TopicStream& stream,
-                   const rosbag::MessageInstance& message,
+                   const internal::SourceMessage& message,
                    const Status& cause);
+  std::string Where(const TopicStream& stream, const internal::SourceMessage& message) const;
   void Skip(SkipReason reason, const TopicStream& stream, int64_t count = 1);
   bool AcceptStamp(TopicStream* stream, int64_t stamp_ns, SkipReason reason);
 
   std::string path_;
   BagReaderOptions options_;
-  int64_t start_time_ns_ = 0;
-  int64_t end_time_ns_ = 0;
-  rosbag::Bag bag_;  // declared before streams_: the views point into it
+  std::unique_ptr<internal::BagSource> source_;  // declared before streams_: they read it
   std::vector<TopicStream> streams_;
+  std::string imu_topic_;
+  std::string lidar_topic_;
+  std::string ground_truth_topic_;
   LidarMessageType lidar_type_ = LidarMessageType::kPointCloud2;
-  std::vector<uint8_t> buffer_;
+  GroundTruthMessageType ground_truth_type_ = GroundTruthMessageType::kPoseStamped;
+  double scan_period_s_ = internal::kDefaultScanPeriodS;
+  bool scan_period_measured_ = false;
   ReadStats stats_;
   std::array<bool, kNumSkipReasons> warned_{};
   bool warned_no_point_time_ = false;
   bool failed_ = false;
 };
 
-Status BagReader::Impl::CheckTopic(const std::vector<const rosbag::ConnectionInfo*>& connections,
-                                   StreamKind kind,
-                                   const std::string& topic,
-                                   bool required,
-                                   bool* found) {
+Status BagReader::Impl::ResolveTopic(StreamKind kind,
+                                     const std::string& configured,
+                                     std::string* resolved) {
+  resolved->clear();
   const std::string key = OptionKey(kind);
-  *found = false;
+  const bool ground_truth = kind == StreamKind::kGroundTruth;
+  if (ground_truth && configured.empty()) return Status::Ok();  // none wanted
+  const bool is_auto = ground_truth ? configured == kAutoTopic : IsAutoTopic(configured);
+  const std::vector<internal::SourceConnection>& connections = source_->connections();
+  if (!is_auto) {
+    for (const internal::SourceConnection& c : connections) {
+      if (c.topic == configured) {
+        *resolved = configured;
+        return Status::Ok();
+      }
+    }
+    // A configured ground-truth topic that is absent means no ground truth:
+    // another odometry topic may be an estimate, not ground truth.
+    if (ground_truth) return Status::Ok();
+  }
+  std::map<std::string, std::string> candidates;  // topic -> datatype
+  for (const internal::SourceConnection& c : connections) {
+    if (TypeMatches(kind, c.datatype)) candidates.emplace(c.topic, c.datatype);
+  }
+  const std::string what = is_auto ? key + " is '" + configured + "' (find by type)"
+                                   : key + " '" + configured + "' not found";
+  if (candidates.size() == 1) {
+    *resolved = candidates.begin()->first;
+    if (!is_auto) {
+      LOG(WARNING) << "bag '" << path_ << "': " << what << "; using '" << *resolved
+                   << "', the only " << candidates.begin()->second << " topic (set " << key
+                   << " to silence this)";
+    }
+    return Status::Ok();
+  }
+  if (candidates.empty()) {
+    if (ground_truth) return Status::Ok();
+    return Status::NotFound("bag '" + path_ + "': " + what + ", and no topic has type " +
+                            AcceptedTypes(kind) +
+                            "; the bag has topics: " + internal::DescribeTopics(connections));
+  }
+  std::string list;
+  for (const auto& [topic, datatype] : candidates) {
+    list += (list.empty() ? "" : ", ") + topic + " [" + datatype + "]";
+  }
+  return Status::NotFound("bag '" + path_ + "': " + what + ", and " +
+                          std::to_string(candidates.size()) + " topics have type " +
+                          AcceptedTypes(kind) + ": " + list + "; set " + key + " to one of them");
+}
+
+Status BagReader::Impl::CheckTopic(StreamKind kind, const std::string& topic) {
+  const std::string key = OptionKey(kind);
   std::string type_found;
-  for (const rosbag::ConnectionInfo* c : connections) {
-    if (c->topic != topic) continue;
-    *found = true;
-    std::string expected;
+  for (const internal::SourceConnection& c : source_->connections()) {
+    if (c.topic != topic) continue;
     bool type_ok = false;
     bool md5_ok = false;
     if (kind == StreamKind::kImu) {
-      expected = kImuType;
-      type_ok = c->datatype == kImuType;
-      md5_ok = c->md5sum == ros::message_traits::MD5Sum<sensor_msgs::Imu>::value();
+      type_ok = c.datatype == kImuType;
+      md5_ok = c.md5sum == ros::message_traits::MD5Sum<sensor_msgs::Imu>::value();
     } else if (kind == StreamKind::kGroundTruth) {
-      expected = kPoseStampedType;
-      type_ok = c->datatype == kPoseStampedType;
-      md5_ok = c->md5sum == ros::message_traits::MD5Sum<geometry_msgs::PoseStamped>::value();
-    } else {
-      expected = std::string(kPointCloud2Type) + " or " + kCustomMsgTypes[0];
-      LidarMessageType type = LidarMessageType::kPointCloud2;
-      if (c->datatype == kPointCloud2Type) {
+      GroundTruthMessageType type = GroundTruthMessageType::kPoseStamped;
+      if (c.datatype == kPoseStampedType) {
         type_ok = true;
-        md5_ok = c->md5sum == ros::message_traits::MD5Sum<sensor_msgs::PointCloud2>::value();
-      } else {
-        for (const char* custom : kCustomMsgTypes) {
-          if (c->datatype == custom) {
-            type_ok = true;
-            type = LidarMessageType::kLivoxCustomMsg;
-            md5_ok = c->md5sum == kLivoxCustomMsgMd5;
-          }
+        md5_ok = c.md5sum == ros::message_traits::MD5Sum<geometry_msgs::PoseStamped>::value();
+      } else if (c.datatype == internal::kNavOdometryDataType) {
+        type_ok = true;
+        type = GroundTruthMessageType::kOdometry;
+        md5_ok = c.md5sum == internal::kNavOdometryMd5;
+      }
+      if (type_ok) {
+        if (!type_found.empty() && type != ground_truth_type_) {
+          return Status::InvalidArgument("bag '" + path_ + "': " + key + " '" + topic +
+                                         "' carries several message types");
         }
+        ground_truth_type_ = type;
+      }
+    } else {
+      LidarMessageType type = LidarMessageType::kPointCloud2;
+      if (c.datatype == kPointCloud2Type) {
+        type_ok = true;
+        md5_ok = c.md5sum == ros::message_traits::MD5Sum<sensor_msgs::PointCloud2>::value();
+      } else if (IsCustomMsgType(c.datatype)) {
+        type_ok = true;
+        type = LidarMessageType::kLivoxCustomMsg;
+        md5_ok = c.md5sum == kLivoxCustomMsgMd5;
       }
       if (type_ok) {
         if (!type_found.empty() && type != lidar_type_) {
@@ -188,19 +279,14 @@ Status BagReader::Impl::CheckTopic(const std::vector<const rosbag::ConnectionInf
     }
     if (!type_ok) {
       return Status::InvalidArgument("bag '" + path_ + "': " + key + " '" + topic + "' has type " +
-                                     c->datatype + ", expected " + expected);
+                                     c.datatype + ", expected " + AcceptedTypes(kind));
     }
     if (!md5_ok) {
       return Status::InvalidArgument("bag '" + path_ + "': " + key + " '" + topic + "' type " +
-                                     c->datatype + " has MD5 " + c->md5sum +
+                                     c.datatype + " has MD5 " + c.md5sum +
                                      ", which does not match the supported definition");
     }
-    type_found = c->datatype;
-  }
-  if (required && !*found) {
-    return Status::NotFound(
-        "bag '" + path_ + "': " + key + " '" + topic +
-        "' not found; the bag has topics: " + internal::DescribeTopics(connections));
+    type_found = c.datatype;
   }
   return Status::Ok();
 }
@@ -209,47 +295,45 @@ Status BagReader::Impl::AddStream(StreamKind kind, const std::string& topic) {
   TopicStream stream;
   stream.kind = kind;
   stream.topic = topic;
-  stream.view = std::make_unique<rosbag::View>(bag_, rosbag::TopicQuery(topic));
+  SWARMLIO_RETURN_IF_ERROR(source_->OpenTopic(topic, &stream.messages));
   streams_.push_back(std::move(stream));
-  TopicStream& added = streams_.back();
-  added.it = added.view->begin();
-  added.end = added.view->end();
   return Status::Ok();
 }
 
 Status BagReader::Impl::Open() {
   const std::string error = options_.Validate();
   if (!error.empty()) return Status::InvalidArgument("BagReaderOptions: " + error);
-  SWARMLIO_RETURN_IF_ERROR(internal::OpenBagForReading(path_, options_.verify_chunks, &bag_));
-  try {
-    rosbag::View all(bag_);
-    if (all.size() > 0) {
-      start_time_ns_ = internal::StampNsFromRosTime(all.getBeginTime());
-      end_time_ns_ = internal::StampNsFromRosTime(all.getEndTime());
-    }
-    const std::vector<const rosbag::ConnectionInfo*> connections = all.getConnections();
-    bool found_imu = false;
-    bool found_lidar = false;
-    bool found_gt = false;
-    SWARMLIO_RETURN_IF_ERROR(
-        CheckTopic(connections, StreamKind::kImu, options_.imu_topic, true, &found_imu));
-    SWARMLIO_RETURN_IF_ERROR(
-        CheckTopic(connections, StreamKind::kLidar, options_.lidar_topic, true, &found_lidar));
-    if (!options_.ground_truth_topic.empty()) {
-      SWARMLIO_RETURN_IF_ERROR(CheckTopic(connections, StreamKind::kGroundTruth,
-                                          options_.ground_truth_topic, false, &found_gt));
-    }
-    // Stream order = tie-break order of equal stamps.
-    streams_.reserve(3);
-    SWARMLIO_RETURN_IF_ERROR(AddStream(StreamKind::kImu, options_.imu_topic));
-    SWARMLIO_RETURN_IF_ERROR(AddStream(StreamKind::kLidar, options_.lidar_topic));
-    if (found_gt) {
-      SWARMLIO_RETURN_IF_ERROR(AddStream(StreamKind::kGroundTruth, options_.ground_truth_topic));
-    }
-  } catch (const std::exception& e) {
-    return internal::StatusFromException(path_, "reading the index", e);
-  } catch (...) {
-    return internal::UnknownExceptionStatus(path_, "reading the index");
+  internal::BagSourceOptions source_options;
+  source_options.verify_chunks = options_.verify_chunks;
+  source_options.recover = options_.recover_damaged_bags;
+  SWARMLIO_RETURN_IF_ERROR(internal::BagSource::Open(path_, source_options, &source_));
+  stats_.recovery = source_->recovery();
+  stats_.skipped[static_cast<size_t>(SkipReason::kDamagedRecord)] = stats_.recovery.damaged_records;
+
+  SWARMLIO_RETURN_IF_ERROR(ResolveTopic(StreamKind::kImu, options_.imu_topic, &imu_topic_));
+  SWARMLIO_RETURN_IF_ERROR(ResolveTopic(StreamKind::kLidar, options_.lidar_topic, &lidar_topic_));
+  SWARMLIO_RETURN_IF_ERROR(
+      ResolveTopic(StreamKind::kGroundTruth, options_.ground_truth_topic, &ground_truth_topic_));
+  SWARMLIO_RETURN_IF_ERROR(CheckTopic(StreamKind::kImu, imu_topic_));
+  SWARMLIO_RETURN_IF_ERROR(CheckTopic(StreamKind::kLidar, lidar_topic_));
+  if (!ground_truth_topic_.empty()) {
+    SWARMLIO_RETURN_IF_ERROR(CheckTopic(StreamKind::kGroundTruth, ground_truth_topic_));
+  }
+  if (options_.check_point_time_span && lidar_type_ == LidarMessageType::kPointCloud2) {
+    std::vector<int64_t> times;
+    SWARMLIO_RETURN_IF_ERROR(source_->TopicTimes(lidar_topic_, kScanPeriodSamples, &times));
+    scan_period_s_ = internal::EstimateScanPeriodS(times);
+    scan_period_measured_ = times.size() >= 2;
+  }
+  if (stats_.recovery.recovered) {
+    LOG(WARNING) << "bag '" << path_ << "' is damaged: " << stats_.recovery.Summary();
+  }
+  // Stream order = tie-break order of equal stamps.
+  streams_.reserve(3);
+  SWARMLIO_RETURN_IF_ERROR(AddStream(StreamKind::kImu, imu_topic_));
+  SWARMLIO_RETURN_IF_ERROR(AddStream(StreamKind::kLidar, lidar_topic_));
+  if (!ground_truth_topic_.empty()) {
+    SWARMLIO_RETURN_IF_ERROR(AddStream(StreamKind::kGroundTruth, ground_truth_topic_));
   }
   return Status::Ok();
 }
@@ -274,31 +358,31 @@ bool BagReader::Impl::AcceptStamp(TopicStream* stream, int64_t stamp_ns, SkipRea
   return true;
 }
 
+std::string BagReader::Impl::Where(const TopicStream& stream,
+                                   const internal::SourceMessage& message) const {
+  return "bag '" + path_ + "': topic '" + stream.topic + "' message #" +
+         std::to_string(stream.message_index) + " (" + message.datatype + ", bag time " +
+         std::to_string(message.bag_time_ns) + " ns)";
+}
+
 Status BagReader::Impl::Malformed(const TopicStream& stream,
-                                  const rosbag::MessageInstance& message,
+                                  const internal::SourceMessage& message,
                                   const Status& cause) {
   if (options_.skip_malformed_messages) {
     Skip(SkipReason::kMalformedMessage, stream);
     return Status::Ok();
   }
-  return Status::DataLoss(
-      "bag '" + path_ + "': topic '" + stream.topic + "' message #" +
-      std::to_string(stream.message_index) + " (" + message.getDataType() + ", bag time " +
-      std::to_string(internal::StampNsFromRosTime(message.getTime())) + " ns): " + cause.message());
+  return Status::DataLoss(Where(stream, message) + ": " + cause.message());
 }
 
-Status BagReader::Impl::Consume(TopicStream* stream, const rosbag::MessageInstance& message) {
-  const uint64_t size = message.size();
-  const uint64_t max_bytes = static_cast<uint64_t>(options_.max_message_mib) << 20;
-  if (size > max_bytes) {
+Status BagReader::Impl::Consume(TopicStream* stream, const internal::SourceMessage& message) {
+  if (message.too_large) {
     return Malformed(*stream, message,
-                     Status::DataLoss("message size " + std::to_string(size) +
+                     Status::DataLoss("message size " + std::to_string(message.size) +
                                       " bytes exceeds max_message_mib"));
   }
-  buffer_.resize(size);
-  ros::serialization::OStream out(buffer_.data(), static_cast<uint32_t>(size));
-  message.write(out);
-  const uint8_t* data = buffer_.data();
+  const uint8_t* data = message.data;
+  const size_t size = message.size;
 
   switch (stream->kind) {
     case StreamKind::kImu: {
@@ -316,6 +400,7 @@ Status BagReader::Impl::Consume(TopicStream* stream, const rosbag::MessageInstan
     case StreamKind::kLidar: {
       LidarScan scan;
       bool without_point_time = false;
+      std::string time_field;
       Status status;
       if (lidar_type_ == LidarMessageType::kLivoxCustomMsg) {
         status = internal::DecodeLivoxCustomMsg(data, size, &scan);
@@ -326,6 +411,7 @@ Status BagReader::Impl::Consume(TopicStream* stream, const rosbag::MessageInstan
         internal::PointCloud2DecodeInfo info;
         status = internal::DecodePointCloud2(data, size, decode_options, &scan, &info);
         without_point_time = status.ok() && !info.has_time_field;
+        time_field = info.time_field;
       }
       if (!status.ok()) return Malformed(*stream, message, status);
       const int64_t dropped = DropNonFinitePoints(&scan);
@@ -333,6 +419,14 @@ Status BagReader::Impl::Consume(TopicStream* stream, const rosbag::MessageInstan
       if (scan.points.empty()) {
         Skip(SkipReason::kScanEmpty, *stream);
         return Status::Ok();
+      }
+      if (options_.check_point_time_span && lidar_type_ == LidarMessageType::kPointCloud2 &&
+          !without_point_time) {
+        const std::string problem = internal::CheckPointTimeSpan(
+            scan, options_.point_time_unit, time_field, scan_period_s_, scan_period_measured_);
+        if (!problem.empty()) {
+          return Status::InvalidArgument(Where(*stream, message) + ": " + problem);
+        }
       }
       if (!AcceptStamp(stream, scan.stamp_ns, SkipReason::kScanNonMonotonic)) return Status::Ok();
       if (without_point_time && !warned_no_point_time_) {
@@ -349,7 +443,9 @@ Status BagReader::Impl::Consume(TopicStream* stream, const rosbag::MessageInstan
     }
     case StreamKind::kGroundTruth: {
       PoseStamped pose;
-      const Status status = internal::DecodePoseStamped(data, size, &pose);
+      const Status status = ground_truth_type_ == GroundTruthMessageType::kOdometry
+                                ? internal::DecodeOdometryPose(data, size, &pose)
+                                : internal::DecodePoseStamped(data, size, &pose);
       if (!status.ok()) return Malformed(*stream, message, status);
       if (!pose.p_b_in_G.allFinite() || !pose.q_G_b.coeffs().allFinite()) {
         Skip(SkipReason::kPoseNonFinite, *stream);
@@ -364,14 +460,17 @@ Status BagReader::Impl::Consume(TopicStream* stream, const rosbag::MessageInstan
 }
 
 Status BagReader::Impl::Fill(TopicStream* stream) {
+  const uint64_t max_bytes = static_cast<uint64_t>(options_.max_message_mib) << 20;
   while (!stream->pending.has_value() && !stream->exhausted) {
-    if (stream->it == stream->end) {
+    internal::SourceMessage message;
+    bool has_message = false;
+    SWARMLIO_RETURN_IF_ERROR(stream->messages->Next(max_bytes, &message, &has_message));
+    if (!has_message) {
       stream->exhausted = true;
       break;
     }
-    SWARMLIO_RETURN_IF_ERROR(Consume(stream, *stream->it));
-    ++stream->it;
     ++stream->message_index;
+    SWARMLIO_RETURN_IF_ERROR(Consume(stream, message));
   }
   return Status::Ok();
 }
@@ -382,15 +481,9 @@ Status BagReader::Impl::Next(BagRecord* record, bool* has_record) {
     return Status::FailedPrecondition("bag '" + path_ + "': reader stopped after an error");
   }
   Status status;
-  try {
-    for (TopicStream& stream : streams_) {
-      status = Fill(&stream);
-      if (!status.ok()) break;
-    }
-  } catch (const std::exception& e) {
-    status = internal::StatusFromException(path_, "reading a message", e);
-  } catch (...) {
-    status = internal::UnknownExceptionStatus(path_, "reading a message");
+  for (TopicStream& stream : streams_) {
+    status = Fill(&stream);
+    if (!status.ok()) break;
   }
   if (!status.ok()) {
     failed_ = true;
@@ -449,7 +542,14 @@ const ReadStats& BagReader::stats() const { return impl_->stats(); }
 const BagReaderOptions& BagReader::options() const { return impl_->options(); }
 const std::string& BagReader::path() const { return impl_->path(); }
 LidarMessageType BagReader::lidar_message_type() const { return impl_->lidar_message_type(); }
+GroundTruthMessageType BagReader::ground_truth_message_type() const {
+  return impl_->ground_truth_message_type();
+}
 bool BagReader::has_ground_truth() const { return impl_->has_ground_truth(); }
+const std::string& BagReader::imu_topic() const { return impl_->imu_topic(); }
+const std::string& BagReader::lidar_topic() const { return impl_->lidar_topic(); }
+const std::string& BagReader::ground_truth_topic() const { return impl_->ground_truth_topic(); }
+double BagReader::scan_period_s() const { return impl_->scan_period_s(); }
 int64_t BagReader::start_time_ns() const { return impl_->start_time_ns(); }
 int64_t BagReader::end_time_ns() const { return impl_->end_time_ns(); }
 

@@ -89,10 +89,18 @@ class BagWriter::Impl {
   }
 
   Status WriteGroundTruth(const PoseStamped& pose, int64_t record_time_ns) {
-    geometry_msgs::PoseStamped msg;
-    SWARMLIO_RETURN_IF_ERROR(internal::EncodePoseStamped(pose, pose_seq_, &msg)
-                                 .WithContext("bag '" + path_ + "': ground truth"));
-    SWARMLIO_RETURN_IF_ERROR(Write(options_.ground_truth_topic, record_time_ns, msg));
+    const std::string context = "bag '" + path_ + "': ground truth";
+    if (options_.ground_truth_format == GroundTruthFormat::kOdometry) {
+      internal::NavOdometry msg;
+      SWARMLIO_RETURN_IF_ERROR(
+          internal::EncodeOdometry(pose, pose_seq_, &msg).WithContext(context));
+      SWARMLIO_RETURN_IF_ERROR(Write(options_.ground_truth_topic, record_time_ns, msg));
+    } else {
+      geometry_msgs::PoseStamped msg;
+      SWARMLIO_RETURN_IF_ERROR(
+          internal::EncodePoseStamped(pose, pose_seq_, &msg).WithContext(context));
+      SWARMLIO_RETURN_IF_ERROR(Write(options_.ground_truth_topic, record_time_ns, msg));
+    }
     ++pose_seq_;
     return Status::Ok();
   }

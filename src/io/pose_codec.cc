@@ -1,22 +1,71 @@
 #include "src/io/pose_codec.h"
 
+#include <string>
+
 #include "src/io/header_codec.h"
 #include "src/io/ros_time.h"
 #include "src/io/wire_reader.h"
 
 namespace swarmlio::io::internal {
+namespace {
+
+// float64[36] covariance of PoseWithCovariance / TwistWithCovariance.
+constexpr size_t kCovarianceBytes = 36 * 8;
+// Twist: linear and angular float64 x y z.
+constexpr size_t kTwistBytes = 6 * 8;
+
+// geometry_msgs/Pose: position x y z, orientation x y z w.
+Status ReadPose(WireReader* reader,
+                const char* position,
+                const char* orientation,
+                PoseStamped* pose) {
+  for (int i = 0; i < 3; ++i) {
+    SWARMLIO_RETURN_IF_ERROR(reader->ReadF64(position, &pose->p_b_in_G[i]));
+  }
+  // geometry_msgs/Quaternion is x, y, z, w, as Eigen's coeffs().
+  for (int i = 0; i < 4; ++i) {
+    SWARMLIO_RETURN_IF_ERROR(reader->ReadF64(orientation, &pose->q_G_b.coeffs()[i]));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
 
 Status DecodePoseStamped(const uint8_t* data, size_t size, PoseStamped* pose) {
   WireReader reader(data, size);
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &pose->stamp_ns, &pose->frame_id));
-  for (int i = 0; i < 3; ++i) {
-    SWARMLIO_RETURN_IF_ERROR(reader.ReadF64("pose.position", &pose->p_b_in_G[i]));
-  }
-  // geometry_msgs/Quaternion is x, y, z, w, as Eigen's coeffs().
-  for (int i = 0; i < 4; ++i) {
-    SWARMLIO_RETURN_IF_ERROR(reader.ReadF64("pose.orientation", &pose->q_G_b.coeffs()[i]));
-  }
+  SWARMLIO_RETURN_IF_ERROR(ReadPose(&reader, "pose.position", "pose.orientation", pose));
   return reader.ExpectEnd("geometry_msgs/PoseStamped");
+}
+
+Status DecodeOdometryPose(const uint8_t* data, size_t size, PoseStamped* pose) {
+  WireReader reader(data, size);
+  SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &pose->stamp_ns, &pose->frame_id));
+  std::string child_frame_id;
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadString("child_frame_id", &child_frame_id));
+  SWARMLIO_RETURN_IF_ERROR(ReadPose(&reader, "pose.pose.position", "pose.pose.orientation", pose));
+  const uint8_t* skipped = nullptr;
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("pose.covariance", kCovarianceBytes, &skipped));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("twist.twist", kTwistBytes, &skipped));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("twist.covariance", kCovarianceBytes, &skipped));
+  return reader.ExpectEnd(kNavOdometryDataType);
+}
+
+Status EncodeOdometry(const PoseStamped& pose, uint32_t seq, NavOdometry* msg) {
+  *msg = NavOdometry();
+  msg->header.seq = seq;
+  SWARMLIO_RETURN_IF_ERROR(RosTimeFromStampNs(pose.stamp_ns, &msg->header.stamp));
+  msg->header.frame_id = pose.frame_id;
+  msg->child_frame_id = "body";
+  geometry_msgs::Pose& p = msg->pose.pose;
+  p.position.x = pose.p_b_in_G.x();
+  p.position.y = pose.p_b_in_G.y();
+  p.position.z = pose.p_b_in_G.z();
+  p.orientation.x = pose.q_G_b.x();
+  p.orientation.y = pose.q_G_b.y();
+  p.orientation.z = pose.q_G_b.z();
+  p.orientation.w = pose.q_G_b.w();
+  return Status::Ok();
 }
 
 Status EncodePoseStamped(const PoseStamped& pose, uint32_t seq, geometry_msgs::PoseStamped* msg) {

@@ -1,4 +1,5 @@
-// geometry_msgs/PoseStamped <-> PoseStamped (body frame b in global frame G).
+// Ground truth: geometry_msgs/PoseStamped and nav_msgs/Odometry (its pose
+// part) <-> PoseStamped (body frame b in global frame G).
 #pragma once
 
 #include <geometry_msgs/PoseStamped.h>
@@ -6,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "src/io/odometry_msg.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/sensors/measurements.h"
 
@@ -16,5 +18,14 @@ namespace swarmlio::io::internal {
 Status DecodePoseStamped(const uint8_t* data, size_t size, PoseStamped* pose);
 
 Status EncodePoseStamped(const PoseStamped& pose, uint32_t seq, geometry_msgs::PoseStamped* msg);
+
+/// Decodes the serialized bytes of one nav_msgs/Odometry: header and
+/// pose.pose (quaternion as stored); child_frame_id, the covariances and the
+/// twist are checked for length and skipped.
+Status DecodeOdometryPose(const uint8_t* data, size_t size, PoseStamped* pose);
+
+/// An Odometry with the pose, child_frame_id "body", zero twist and
+/// covariances.
+Status EncodeOdometry(const PoseStamped& pose, uint32_t seq, NavOdometry* msg);
 
 }  // namespace swarmlio::io::internal

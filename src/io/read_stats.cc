@@ -22,10 +22,25 @@ const char* SkipReasonName(SkipReason reason) {
       return "pose_non_monotonic";
     case SkipReason::kMalformedMessage:
       return "malformed_message";
+    case SkipReason::kDamagedRecord:
+      return "damaged_record";
     case SkipReason::kNumReasons:
       break;
   }
   return "?";
+}
+
+std::string BagRecoveryStats::Summary() const {
+  if (!recovered) return "";
+  std::ostringstream os;
+  os << "recovered " << messages << " messages by scanning the records (" << reason << ")";
+  if (damaged_records > 0 || damaged_bytes > 0) {
+    os << "; " << damaged_records << " damaged records, " << damaged_bytes
+       << " bytes unreadable from offset " << damage_offset;
+  } else {
+    os << "; no message lost";
+  }
+  return os.str();
 }
 
 int64_t ReadStats::TotalSkipped() const {
@@ -44,6 +59,7 @@ std::string ReadStats::ToString() const {
   for (size_t i = 0; i < kNumSkipReasons; ++i) {
     os << "skipped." << SkipReasonName(static_cast<SkipReason>(i)) << ": " << skipped[i] << "\n";
   }
+  if (recovery.recovered) os << "recovery: " << recovery.Summary() << "\n";
   return os.str();
 }
 

@@ -368,6 +368,9 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
                       scan.previous_scan_degenerate;
   im.part.frozen = frozen && x->layout().NumTeammates() > 0;
   std::set<int> estimated;
+  // A well-localized drone does not take a degenerate teammate's pose into
+  // its own state; a degenerate one still does (it is its best information).
+  const bool skip_degenerate = so.skip_degenerate_teammates && !scan.previous_scan_degenerate;
   const double gate2 = so.gate_sigma * so.gate_sigma;
   const auto add = [&](std::unique_ptr<ceres::CostFunction> cost, int teammate_id,
                        const Eigen::Vector3d& innovation, const Eigen::Matrix3d& S) {
@@ -394,7 +397,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
         continue;
       }
       const net::EgoStateMessage& m = it->second.last;
-      if (so.skip_degenerate_teammates && m.degenerated) {
+      if (skip_degenerate && m.degenerated) {
         ++im.part.skipped_degenerate;
         continue;
       }
@@ -421,7 +424,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
   if (so.fuse_passive && fusion_enabled_) {
     for (const PendingPassive& p : im.passive) {
       if (!x->HasTeammate(p.from)) continue;
-      if (so.skip_degenerate_teammates && p.sender.degenerated) {
+      if (skip_degenerate && p.sender.degenerated) {
         ++im.part.skipped_degenerate;
         continue;
       }

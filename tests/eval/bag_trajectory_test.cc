@@ -11,9 +11,11 @@ namespace swarmlio::eval {
 namespace {
 
 // A bag with IMU samples, one scan and `num_poses` ground-truth poses.
-void WriteBag(const std::string& path, int num_poses) {
+void WriteBag(const std::string& path,
+              int num_poses,
+              const io::BagWriterOptions& options = io::BagWriterOptions()) {
   std::unique_ptr<io::BagWriter> writer;
-  ASSERT_TRUE(io::BagWriter::Open(path, io::BagWriterOptions(), &writer).ok());
+  ASSERT_TRUE(io::BagWriter::Open(path, options, &writer).ok());
   const int64_t t0_ns = 2000000000;
   LidarScan scan;
   scan.stamp_ns = t0_ns;
@@ -51,6 +53,25 @@ TEST(BagGroundTruth, ReadsThePoses) {
     EXPECT_EQ(trajectory.T_G_b[i].translation(), Eigen::Vector3d(0.5 * i, -0.25 * i, 1.0));
     EXPECT_NEAR(Eigen::AngleAxisd(trajectory.T_G_b[i].linear()).angle(), 0.1 * i, 1e-12);
   }
+}
+
+TEST(BagGroundTruth, ReadsOdometryOnOtherTopics) {
+  testing::TempDir dir;
+  const std::string path = dir.File("odom.bag");
+  io::BagWriterOptions writer_options;
+  writer_options.imu_topic = "/mavros/imu/data";
+  writer_options.lidar_topic = "/os_cloud_node/points";
+  writer_options.ground_truth_topic = "/vicon/uav1/odom";
+  writer_options.ground_truth_format = io::GroundTruthFormat::kOdometry;
+  WriteBag(path, 5, writer_options);
+  io::BagReaderOptions options;
+  options.ground_truth_topic = "auto";  // IMU and LiDAR: defaults, absent, found by type
+  Trajectory trajectory;
+  const Status status = ReadBagGroundTruth(path, options, &trajectory);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(trajectory.size(), 5u);
+  EXPECT_EQ(trajectory.stamps_s[4], StampSeconds(2000000000 + 4 * 10000000LL + 7));
+  EXPECT_EQ(trajectory.T_G_b[4].translation(), Eigen::Vector3d(2.0, -1.0, 1.0));
 }
 
 TEST(BagGroundTruth, Errors) {

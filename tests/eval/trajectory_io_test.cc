@@ -96,6 +96,75 @@ TEST(TumReader, MissingAndEmptyFiles) {
   EXPECT_NE(empty.message().find("no poses"), std::string::npos);
 }
 
+// The first lines of EuRoC MH_01_easy's state_groundtruth_estimate0/data.csv
+// (17 columns: position, quaternion w x y z, velocity, gyro and accel biases).
+constexpr char kEurocHead[] =
+    "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
+    "q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], "
+    "b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], "
+    "b_a_RS_S_z [m s^-2]\n"
+    "1403636580838555648,4.688319,-1.786938,0.783338,0.534108,-0.153029,-0.827383,-0.082152,"
+    "-0.027876,0.033207,0.800006,-0.003172,0.021267,0.078502,-0.025266,0.136696,0.075593\n"
+    "1403636580843555328,4.688177,-1.786770,0.787004,0.534640,-0.152702,-0.826862,-0.082240,"
+    "-0.029272,0.033992,0.804100,-0.003172,0.021267,0.078502,-0.025266,0.136696,0.075593\r\n";
+
+TEST(EurocReader, ReadsTheGroundTruthCsvAsEvoDoes) {
+  testing::TempDir dir;
+  const std::string path = dir.Write("data.csv", kEurocHead);
+  Trajectory trajectory;
+  TrajectoryReadStats stats;
+  const Status status = ReadEurocTrajectory(path, {}, &trajectory, &stats);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(trajectory.size(), 2u);
+  EXPECT_EQ(stats.pose_lines, 2);
+  EXPECT_EQ(stats.skipped_lines, 1);
+  // evo: float64 of the ns stamp, divided by 1e9.
+  EXPECT_TRUE(BitEqual(trajectory.stamps_s[0], 1403636580838555648.0 / 1e9));
+  EXPECT_TRUE(BitEqual(trajectory.stamps_s[1], 1403636580843555328.0 / 1e9));
+  EXPECT_EQ(trajectory.T_G_b[0].translation(), Eigen::Vector3d(4.688319, -1.786938, 0.783338));
+  // Quaternion scalar first, normalised.
+  const Eigen::Quaterniond q =
+      Eigen::Quaterniond(0.534108, -0.153029, -0.827383, -0.082152).normalized();
+  EXPECT_LT((trajectory.T_G_b[0].linear() - q.toRotationMatrix()).norm(), 1e-15);
+
+  // The same through ReadTrajectory, and spaces around values.
+  const std::string spaced = dir.Write(
+      "spaced.csv", "# t, x, y, z, qw, qx, qy, qz\n\n 2000000000 , 1, 2, 3, 1, 0, 0, 0\n");
+  ASSERT_TRUE(ReadTrajectory(spaced, TrajectoryFormat::kEuroc, {}, &trajectory).ok());
+  ASSERT_EQ(trajectory.size(), 1u);
+  EXPECT_EQ(trajectory.stamps_s[0], 2.0);
+  EXPECT_EQ(trajectory.T_G_b[0].translation(), Eigen::Vector3d(1, 2, 3));
+  EXPECT_TRUE(trajectory.T_G_b[0].linear().isIdentity());
+}
+
+TEST(EurocReader, BadInputNamesFileAndLine) {
+  const BadFile cases[] = {
+      {"#h\n1,0,0,0,1,0,0\n", "expected at least 8 comma-separated values", 2},
+      {"1,0,0,0,1,0,0,0\n2,0,x,0,1,0,0,0\n", "value 3 'x' is not a number", 2},
+      {"1,0,0,0,1,0,0,0\n2,0,,0,1,0,0,0\n", "value 3 '' is not a number", 2},
+      {"2,0,0,0,1,0,0,0\n1,0,0,0,1,0,0,0\n", "does not increase (line 1)", 2},
+      {"1,0,0,0,0,0,0,0\n", "zero quaternion", 1},
+      {"1 0 0 0 1 0 0 0\n", "expected at least 8 comma-separated values", 1},
+  };
+  testing::TempDir dir;
+  for (const BadFile& c : cases) {
+    const std::string path = dir.Write("bad.csv", c.text);
+    Trajectory trajectory;
+    const Status status = ReadEurocTrajectory(path, {}, &trajectory);
+    ASSERT_FALSE(status.ok()) << c.text;
+    EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
+    const std::string where = path + ":" + std::to_string(c.line) + ": ";
+    EXPECT_EQ(status.message().rfind(where, 0), 0u) << status.message();
+    EXPECT_NE(status.message().find(c.expected), std::string::npos) << status.message();
+  }
+  Trajectory trajectory;
+  EXPECT_EQ(ReadEurocTrajectory(dir.File("none.csv"), {}, &trajectory).code(),
+            Status::Code::kNotFound);
+  // A EuRoC file read as TUM says what it probably is.
+  const Status as_tum = ReadTumTrajectory(dir.Write("gt.csv", kEurocHead), {}, &trajectory);
+  EXPECT_NE(as_tum.message().find("euroc format"), std::string::npos) << as_tum.message();
+}
+
 TEST(TrajectoryFiles, KittiRoundTripIsBitExact) {
   testing::TempDir dir;
   const Trajectory written = testing::Curve(25);
@@ -154,7 +223,9 @@ TEST(KittiReader, BadInput) {
   TrajectoryFormat format;
   EXPECT_TRUE(TrajectoryFormatFromString("kitti", &format));
   EXPECT_EQ(format, TrajectoryFormat::kKitti);
-  EXPECT_FALSE(TrajectoryFormatFromString("euroc", &format));
+  EXPECT_TRUE(TrajectoryFormatFromString("euroc", &format));
+  EXPECT_EQ(format, TrajectoryFormat::kEuroc);
+  EXPECT_FALSE(TrajectoryFormatFromString("csv", &format));
 }
 
 }  // namespace

@@ -20,9 +20,6 @@ TEST(BagOptionsTest, DefaultsAreValid) {
 
 TEST(BagOptionsTest, ValidateNamesTheKey) {
   BagReaderOptions reader;
-  reader.lidar_topic = "";
-  EXPECT_NE(reader.Validate().find("lidar_topic"), std::string::npos);
-  reader = BagReaderOptions();
   reader.lidar_topic = reader.imu_topic;
   EXPECT_NE(reader.Validate().find("lidar_topic"), std::string::npos);
   reader = BagReaderOptions();
@@ -64,7 +61,26 @@ TEST(BagOptionsTest, OptionsAreVisitable) {
   int count = 0;
   BagReaderOptions options;
   options.VisitFields([&count](const char*, auto&, const config::FieldSpec&) { ++count; });
-  EXPECT_EQ(count, 8);
+  EXPECT_EQ(count, 10);
+}
+
+TEST(BagOptionsTest, EmptyOrAutoTopicsAreValid) {
+  BagReaderOptions reader;
+  reader.imu_topic = "";
+  reader.lidar_topic = "auto";
+  reader.ground_truth_topic = "auto";
+  EXPECT_EQ(reader.Validate(), "");
+  reader.imu_topic = "auto";
+  EXPECT_EQ(reader.Validate(), "");  // two "auto" topics do not clash
+  EXPECT_TRUE(IsAutoTopic(""));
+  EXPECT_TRUE(IsAutoTopic("auto"));
+  EXPECT_FALSE(IsAutoTopic("/auto"));
+  EXPECT_TRUE(BagReaderOptions().check_point_time_span);
+  EXPECT_TRUE(BagReaderOptions().recover_damaged_bags);
+  GroundTruthFormat format = GroundTruthFormat::kPoseStamped;
+  ASSERT_TRUE(config::EnumFromString("odometry", &format));
+  EXPECT_EQ(format, GroundTruthFormat::kOdometry);
+  EXPECT_EQ(BagWriterOptions().ground_truth_format, GroundTruthFormat::kPoseStamped);
 }
 
 TEST(ReadStatsTest, NamesAndSummary) {
@@ -74,6 +90,19 @@ TEST(ReadStatsTest, NamesAndSummary) {
   EXPECT_EQ(stats.TotalSkipped(), 3);
   EXPECT_STREQ(SkipReasonName(SkipReason::kMalformedMessage), "malformed_message");
   EXPECT_NE(stats.ToString().find("skipped.scan_empty: 2"), std::string::npos);
+  EXPECT_STREQ(SkipReasonName(SkipReason::kDamagedRecord), "damaged_record");
+  EXPECT_EQ(stats.ToString().find("recovery:"), std::string::npos);
+  EXPECT_EQ(stats.recovery.Summary(), "");
+  stats.recovery.recovered = true;
+  stats.recovery.reason = "bag is not indexed";
+  stats.recovery.messages = 40;
+  stats.recovery.damaged_records = 1;
+  stats.recovery.damaged_bytes = 77;
+  stats.recovery.damage_offset = 9000;
+  EXPECT_EQ(stats.recovery.Summary(),
+            "recovered 40 messages by scanning the records (bag is not indexed); 1 damaged "
+            "records, 77 bytes unreadable from offset 9000");
+  EXPECT_NE(stats.ToString().find("recovery: recovered 40 messages"), std::string::npos);
 }
 
 }  // namespace

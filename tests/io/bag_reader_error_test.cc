@@ -1,6 +1,7 @@
-// BagReader on broken input: missing, garbage and truncated files, missing
-// topics, wrong types, corrupt messages, NaNs, stamps going backwards and
-// empty scans. Each is an error Status or a counted skip, never a crash.
+// BagReader on broken input: missing, garbage and truncated files (without
+// recovery; bag_recovery_test.cc recovers them), missing topics, wrong types,
+// corrupt messages, NaNs, stamps going backwards and empty scans. Each is an
+// error Status or a counted skip, never a crash.
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
@@ -93,21 +94,28 @@ TEST(BagReaderErrorTest, GarbageFilesAreErrors) {
   }
 }
 
-TEST(BagReaderErrorTest, TruncatedBagIsAnError) {
+TEST(BagReaderErrorTest, TruncatedBagIsAnErrorWithoutRecovery) {
   TempDir dir;
   const std::string path = dir.File("full.bag");
   testing::WriteSimpleBag(path, BagWriterOptions(), 400, 200);
   const uintmax_t size = std::filesystem::file_size(path);
+  BagReaderOptions no_recovery;
+  no_recovery.recover_damaged_bags = false;
   for (double fraction : {0.5, 0.0, 0.001, 0.25, 0.75, 0.99}) {
     const std::string cut = dir.File("cut.bag");
     std::filesystem::copy_file(path, cut, std::filesystem::copy_options::overwrite_existing);
     std::filesystem::resize_file(cut, static_cast<uintmax_t>(size * fraction));
     std::vector<BagRecord> records;
-    const Status status = ReadAll(cut, BagReaderOptions(), &records);
+    const Status status = ReadAll(cut, no_recovery, &records);
     EXPECT_FALSE(status.ok()) << fraction;
     EXPECT_TRUE(Contains(status.message(), cut)) << status.message();
     if (fraction > 0.01) {
       EXPECT_TRUE(Contains(status.message(), "truncated")) << status.message();
+      EXPECT_TRUE(Contains(status.message(), "recover_damaged_bags")) << status.message();
+    }
+    // A file cut inside its file header has nothing to recover.
+    if (fraction < 0.01) {
+      EXPECT_FALSE(ReadAll(cut, BagReaderOptions(), &records).ok());
     }
   }
   // The last byte missing.
@@ -115,7 +123,7 @@ TEST(BagReaderErrorTest, TruncatedBagIsAnError) {
   std::filesystem::copy_file(path, cut);
   std::filesystem::resize_file(cut, size - 1);
   std::vector<BagRecord> records;
-  EXPECT_FALSE(ReadAll(cut, BagReaderOptions(), &records).ok());
+  EXPECT_FALSE(ReadAll(cut, no_recovery, &records).ok());
 }
 
 // Overwrites 16 bytes at ~150 places of a valid bag (record headers, chunk
@@ -171,38 +179,67 @@ TEST(BagReaderErrorTest, UnindexedBagIsReported) {
     const char zeros[8] = {};
     file.write(zeros, sizeof(zeros));
   }
+  BagReaderOptions no_recovery;
+  no_recovery.recover_damaged_bags = false;
   std::unique_ptr<BagReader> reader;
-  const Status status = BagReader::Open(path, BagReaderOptions(), &reader);
+  const Status status = BagReader::Open(path, no_recovery, &reader);
   EXPECT_EQ(status.code(), Status::Code::kDataLoss);
   EXPECT_TRUE(Contains(status.message(), "not indexed")) << status.message();
   BagInfo info;
-  EXPECT_FALSE(ReadBagInfo(path, &info).ok());
+  EXPECT_FALSE(ReadBagInfo(path, &info, /*recover_damaged_bags=*/false).ok());
+  // By default every message is recovered (bag_recovery_test.cc has more).
+  std::vector<BagRecord> records;
+  ReadStats stats;
+  ASSERT_TRUE(ReadAll(path, BagReaderOptions(), &records, &stats).ok());
+  EXPECT_EQ(stats.imu_samples, 20);
+  EXPECT_TRUE(stats.recovery.recovered);
+  EXPECT_TRUE(Contains(stats.recovery.reason, "not indexed")) << stats.recovery.reason;
+  ASSERT_TRUE(ReadBagInfo(path, &info).ok());
+  EXPECT_TRUE(info.recovery.recovered);
+  EXPECT_EQ(info.message_count, 20 + 1 + 2);
 }
 
 TEST(BagReaderErrorTest, MissingTopicsListTheBagsTopics) {
   TempDir dir;
   const std::string path = dir.File("topics.bag");
   testing::WriteSimpleBag(path, BagWriterOptions(), 30);
+  {
+    // An IMU topic and a LiDAR topic of no supported type.
+    rosbag::Bag bag;
+    bag.open(dir.File("no_lidar.bag"), rosbag::bagmode::Write);
+    sensor_msgs::Imu imu;
+    bag.write("/livox/imu", T(5), imu);
+    geometry_msgs::PoseStamped pose;
+    bag.write("/livox/lidar", T(5), pose);
+    bag.close();
+  }
   std::unique_ptr<BagReader> reader;
   BagReaderOptions options;
-  options.imu_topic = "/imu/data";
-  Status status = BagReader::Open(path, options, &reader);
-  EXPECT_EQ(status.code(), Status::Code::kNotFound);
-  EXPECT_TRUE(Contains(status.message(), "/imu/data"));
-  EXPECT_TRUE(Contains(status.message(), "/livox/imu [sensor_msgs/Imu]")) << status.message();
-  EXPECT_TRUE(Contains(status.message(), "/livox/lidar [livox_ros_driver/CustomMsg]"));
-
-  options = BagReaderOptions();
   options.lidar_topic = "/velodyne_points";
-  EXPECT_EQ(BagReader::Open(path, options, &reader).code(), Status::Code::kNotFound);
+  Status status = BagReader::Open(dir.File("no_lidar.bag"), options, &reader);
+  EXPECT_EQ(status.code(), Status::Code::kNotFound);
+  EXPECT_TRUE(Contains(status.message(), "lidar_topic '/velodyne_points' not found"))
+      << status.message();
+  EXPECT_TRUE(Contains(status.message(), "/livox/imu [sensor_msgs/Imu]")) << status.message();
+  EXPECT_TRUE(Contains(status.message(), "/livox/lidar [geometry_msgs/PoseStamped]"));
+
+  // An absent IMU / LiDAR topic is replaced by the only topic of its type.
+  options = BagReaderOptions();
+  options.imu_topic = "/imu/data";
+  options.lidar_topic = "/velodyne_points";
+  ASSERT_TRUE(BagReader::Open(path, options, &reader).ok());
+  EXPECT_EQ(reader->imu_topic(), "/livox/imu");
+  EXPECT_EQ(reader->lidar_topic(), "/livox/lidar");
 
   // A missing ground-truth topic is fine.
   options = BagReaderOptions();
   options.ground_truth_topic = "/vicon/pose";
   ASSERT_TRUE(BagReader::Open(path, options, &reader).ok());
   EXPECT_FALSE(reader->has_ground_truth());
+  EXPECT_EQ(reader->ground_truth_topic(), "");
   options.ground_truth_topic = "";
   ASSERT_TRUE(BagReader::Open(path, options, &reader).ok());
+  EXPECT_FALSE(reader->has_ground_truth());
 }
 
 TEST(BagReaderErrorTest, WrongTypesAreInvalidArgument) {
@@ -449,7 +486,8 @@ TEST(BagReaderErrorTest, InvalidOptionsAreRejected) {
   testing::WriteSimpleBag(path, BagWriterOptions(), 5);
   std::unique_ptr<BagReader> reader;
   BagReaderOptions options;
-  options.imu_topic = "";
+  options.imu_topic = "/same";
+  options.lidar_topic = "/same";
   Status status = BagReader::Open(path, options, &reader);
   EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
   EXPECT_TRUE(Contains(status.message(), "imu_topic"));

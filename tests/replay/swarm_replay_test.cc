@@ -151,10 +151,16 @@ TEST_F(SwarmReplayTest, BadInputsGiveClearErrors) {
   EXPECT_NE(status.message().find("missing.bag"), std::string::npos) << status.message();
 
   m = Manifest();
-  m.drones[0].bag.imu_topic = "/no/such/topic";
+  m.drones[0].bag.imu_topic = "/no/such/topic";  // absent: found by type instead
+  ASSERT_TRUE(SwarmReplay::Create(m, &run).ok());
+  EXPECT_EQ(run->drone(0).reader().imu_topic(), "/livox/imu");
+  m.drones[0].bag.imu_topic = "auto";
+  m.drones[0].bag.lidar_topic = "/livox/imu";  // a topic of the wrong type stays an error
   status = SwarmReplay::Create(m, &run);
   EXPECT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("/no/such/topic"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("lidar_topic '/livox/imu' has type sensor_msgs/Imu"),
+            std::string::npos)
+      << status.message();
 
   ASSERT_TRUE(SwarmReplay::Create(Manifest(), &run).ok());
   ReplayOptions options;

@@ -1,6 +1,8 @@
 // swarmlio_bag_info: prints the topics, message types, counts and time range
-// of a ROS1 bag, then reads the IMU / LiDAR / ground-truth topics with
-// BagReader and prints its statistics (delivered and skipped records).
+// of a ROS1 bag (of a truncated or unindexed bag: what a scan of its records
+// recovered and what was lost), then reads the IMU / LiDAR / ground-truth
+// topics with BagReader (topics found by type when absent) and prints its
+// statistics (delivered and skipped records).
 //
 //   swarmlio_bag_info [--imu_topic=...] [--lidar_topic=...] [--read=false] run.bag
 //
@@ -18,15 +20,28 @@
 #include "swarmlio/io/bag_reader.h"
 
 DEFINE_string(bag, "", "bag file (or give it as the positional argument)");
-DEFINE_string(imu_topic, "/livox/imu", "sensor_msgs/Imu topic");
-DEFINE_string(lidar_topic, "/livox/lidar", "PointCloud2 or livox_ros_driver/CustomMsg topic");
+DEFINE_string(imu_topic,
+              "/livox/imu",
+              "sensor_msgs/Imu topic; 'auto' or absent: the bag's only sensor_msgs/Imu topic");
+DEFINE_string(lidar_topic,
+              "/livox/lidar",
+              "PointCloud2 or livox_ros_driver(2)/CustomMsg topic; 'auto' or absent: the bag's "
+              "only such topic");
 DEFINE_string(ground_truth_topic,
               "/ground_truth/pose",
-              "geometry_msgs/PoseStamped topic (optional)");
+              "geometry_msgs/PoseStamped or nav_msgs/Odometry topic (optional; 'auto': the "
+              "bag's only such topic)");
 DEFINE_string(point_time_unit, "us", "PointCloud2 per-point time unit: s, ms, us or ns");
 DEFINE_string(point_time_field, "", "PointCloud2 per-point time field (empty = auto-detect)");
 DEFINE_bool(read, true, "read the sensor topics and print reader statistics");
 DEFINE_bool(skip_malformed_messages, false, "count undecodable messages instead of failing");
+DEFINE_bool(recover_damaged_bags,
+            true,
+            "read a truncated or unindexed bag by scanning its records (false: an error)");
+DEFINE_bool(check_point_time_span,
+            true,
+            "fail when PointCloud2 per-point times do not fit the scan period in "
+            "--point_time_unit");
 
 namespace {
 
@@ -66,6 +81,9 @@ void PrintInfo(const io::BagInfo& info) {
                 t.topic.c_str(), t.message_count, t.datatype.c_str(),
                 FormatStamp(t.first_time_ns).c_str(), FormatStamp(t.last_time_ns).c_str());
   }
+  if (info.recovery.recovered) {
+    std::printf("damaged:   %s\n", info.recovery.Summary().c_str());
+  }
 }
 
 }  // namespace
@@ -88,7 +106,7 @@ int main(int argc, char** argv) {
   }
 
   io::BagInfo info;
-  Status status = io::ReadBagInfo(path, &info);
+  Status status = io::ReadBagInfo(path, &info, FLAGS_recover_damaged_bags);
   if (!status.ok()) return Fail(status.message());
   PrintInfo(info);
   if (!FLAGS_read) return 0;
@@ -99,6 +117,8 @@ int main(int argc, char** argv) {
   options.ground_truth_topic = FLAGS_ground_truth_topic;
   options.point_time_field = FLAGS_point_time_field;
   options.skip_malformed_messages = FLAGS_skip_malformed_messages;
+  options.recover_damaged_bags = FLAGS_recover_damaged_bags;
+  options.check_point_time_span = FLAGS_check_point_time_span;
   if (!swarmlio::config::EnumFromString(FLAGS_point_time_unit, &options.point_time_unit)) {
     std::fprintf(stderr, "swarmlio_bag_info: error: --point_time_unit '%s' is not one of %s\n",
                  FLAGS_point_time_unit.c_str(),
@@ -121,12 +141,16 @@ int main(int argc, char** argv) {
     last_ns = record.stamp_ns();
     any = true;
   }
-  std::printf("reader (imu %s, lidar %s as %s, ground truth %s):\n", options.imu_topic.c_str(),
-              options.lidar_topic.c_str(),
+  std::printf("reader (imu %s, lidar %s as %s, ground truth %s%s):\n", reader->imu_topic().c_str(),
+              reader->lidar_topic().c_str(),
               reader->lidar_message_type() == io::LidarMessageType::kLivoxCustomMsg
                   ? "livox CustomMsg"
                   : "PointCloud2",
-              reader->has_ground_truth() ? options.ground_truth_topic.c_str() : "(none)");
+              reader->has_ground_truth() ? reader->ground_truth_topic().c_str() : "(none)",
+              !reader->has_ground_truth() ? ""
+              : reader->ground_truth_message_type() == io::GroundTruthMessageType::kOdometry
+                  ? " as Odometry"
+                  : " as PoseStamped");
   if (any) {
     std::printf("  stamps: %s .. %s s\n", FormatStamp(first_ns).c_str(),
                 FormatStamp(last_ns).c_str());

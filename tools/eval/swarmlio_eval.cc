@@ -5,8 +5,10 @@
 //   swarmlio_eval rpe REF EST [--delta=1 --delta_unit=m] ...
 //
 // REF and EST are trajectory sources: PATH (format from --format), tum:PATH,
-// kitti:PATH, or bag:PATH[:TOPIC] for the geometry_msgs/PoseStamped ground
-// truth in a ROS1 bag (default topic --ground_truth_topic).
+// kitti:PATH, euroc:PATH (EuRoC ground-truth CSV, as evo's `euroc`), or
+// bag:PATH[:TOPIC] for the geometry_msgs/PoseStamped or nav_msgs/Odometry
+// ground truth in a ROS1 bag (default topic --ground_truth_topic; IMU and
+// LiDAR topics are found by type when absent).
 //
 // Exit code 0 on success, 1 if the evaluation fails (unreadable input, no
 // overlapping stamps, ...), 2 on bad usage.
@@ -23,7 +25,7 @@
 #include "swarmlio/eval/rpe.h"
 #include "swarmlio/eval/trajectory_io.h"
 
-DEFINE_string(format, "tum", "format of sources given as a plain path: tum or kitti");
+DEFINE_string(format, "tum", "format of sources given as a plain path: tum, kitti or euroc");
 DEFINE_string(align, "none", "alignment of the estimate onto the reference: none, se3, sim3");
 DEFINE_string(relation,
               "trans",
@@ -35,9 +37,16 @@ DEFINE_double(t_offset, 0.0, "offset added to the estimate's stamps [s]");
 DEFINE_bool(allow_duplicate_stamps,
             false,
             "accept equal consecutive stamps in TUM files (evo keeps such poses)");
-DEFINE_string(ground_truth_topic, "/ground_truth/pose", "bag sources: default pose topic");
-DEFINE_string(imu_topic, "/livox/imu", "bag sources: IMU topic (the bag reader needs it)");
-DEFINE_string(lidar_topic, "/livox/lidar", "bag sources: LiDAR topic (the bag reader needs it)");
+DEFINE_string(ground_truth_topic,
+              "/ground_truth/pose",
+              "bag sources: default pose topic (PoseStamped or Odometry; 'auto': the bag's only "
+              "such topic)");
+DEFINE_string(imu_topic,
+              "auto",
+              "bag sources: IMU topic (the bag reader needs it; 'auto': found by type)");
+DEFINE_string(lidar_topic,
+              "auto",
+              "bag sources: LiDAR topic (the bag reader needs it; 'auto': found by type)");
 DEFINE_string(plot_top_view, "", "ape: write an x-y plot of both trajectories to this PNG");
 DEFINE_string(plot_errors, "", "ape: write the error over time to this PNG");
 DEFINE_string(table, "", "write the statistics to TABLE.md, TABLE.csv and TABLE.json");
@@ -89,8 +98,11 @@ Status ReadSource(const std::string& source, eval::Trajectory* trajectory) {
   } else if (StartsWith(source, "kitti:")) {
     format = eval::TrajectoryFormat::kKitti;
     path = source.substr(6);
+  } else if (StartsWith(source, "euroc:")) {
+    format = eval::TrajectoryFormat::kEuroc;
+    path = source.substr(6);
   } else if (!eval::TrajectoryFormatFromString(FLAGS_format, &format)) {
-    return Status::InvalidArgument("--format '" + FLAGS_format + "' is not tum or kitti");
+    return Status::InvalidArgument("--format '" + FLAGS_format + "' is not tum, kitti or euroc");
   }
   return eval::ReadTrajectory(path, format, read_options, trajectory);
 }
@@ -136,7 +148,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "evo-compatible trajectory errors\n"
       "  usage: swarmlio_eval {ape|rpe} REFERENCE ESTIMATE [flags]\n"
-      "  sources: PATH (--format), tum:PATH, kitti:PATH, bag:PATH[:TOPIC]");
+      "  sources: PATH (--format), tum:PATH, kitti:PATH, euroc:PATH, bag:PATH[:TOPIC]");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;

@@ -127,6 +127,11 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
                 d.warnings().first.c_str());
   }
   const io::ReadStats& rs = d.reader().stats();
+  std::printf("  topics: imu %s, lidar %s, ground truth %s\n", d.reader().imu_topic().c_str(),
+              d.reader().lidar_topic().c_str(),
+              d.reader().ground_truth_topic().empty() ? "(none)"
+                                                      : d.reader().ground_truth_topic().c_str());
+  if (rs.recovery.recovered) std::printf("  damaged bag: %s\n", rs.recovery.Summary().c_str());
   if (rs.TotalSkipped() > 0) {
     std::printf("  bag reader skipped records:\n%s", rs.ToString().c_str());
   }

@@ -1,4 +1,4 @@
-// Reading and writing trajectory files in the two formats evo reads.
+// Reading and writing trajectory files in the formats evo reads.
 //
 // TUM:   one pose a line, "stamp tx ty tz qx qy qz qw" (seconds, metres,
 //        Hamilton quaternion, scalar last), whitespace separated; empty lines
@@ -7,6 +7,12 @@
 // KITTI: one pose a line, the 12 entries of the top 3 x 4 block of T_G_b in
 //        row-major order; no stamps. The rotation block is kept as written
 //        (evo does the same) after a check that it is a rotation.
+// EuRoC: (read only) the ground-truth CSV of the EuRoC MAV dataset
+//        (state_groundtruth_estimate0/data.csv), as evo's `euroc` format:
+//        "#timestamp [ns], p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w,
+//        q_RS_x, q_RS_y, q_RS_z, ..." with further columns ignored; lines
+//        starting with '#' and empty lines are skipped. Stamp = ns / 1e9 (as
+//        evo computes it), quaternion scalar first, normalised.
 //
 // Every error names the file and line ("path:line: reason").
 #pragma once
@@ -18,9 +24,9 @@
 
 namespace swarmlio::eval {
 
-enum class TrajectoryFormat { kTum, kKitti };
+enum class TrajectoryFormat { kTum, kKitti, kEuroc };
 
-/// Parses "tum" or "kitti" (false for anything else).
+/// Parses "tum", "kitti" or "euroc" (false for anything else).
 bool TrajectoryFormatFromString(const std::string& text, TrajectoryFormat* format);
 
 struct TrajectoryReadOptions {
@@ -43,12 +49,19 @@ Status ReadTumTrajectory(const std::string& path,
                          Trajectory* trajectory,
                          TrajectoryReadStats* stats = nullptr);
 
+/// Reads a EuRoC ground-truth CSV file (stamps follow the TUM rules of
+/// `options`). `stats` may be null.
+Status ReadEurocTrajectory(const std::string& path,
+                           const TrajectoryReadOptions& options,
+                           Trajectory* trajectory,
+                           TrajectoryReadStats* stats = nullptr);
+
 /// Reads a KITTI file. `stats` may be null.
 Status ReadKittiTrajectory(const std::string& path,
                            Trajectory* trajectory,
                            TrajectoryReadStats* stats = nullptr);
 
-/// Reads `path` in `format` (TUM uses `options`).
+/// Reads `path` in `format` (TUM and EuRoC use `options`).
 Status ReadTrajectory(const std::string& path,
                       TrajectoryFormat format,
                       const TrajectoryReadOptions& options,

@@ -1,4 +1,5 @@
-// Summary of a ROS1 bag from its index (no message is decoded).
+// Summary of a ROS1 bag from its index (no message is decoded). A truncated
+// or unindexed bag is summarized from a scan of its records (recovery).
 #pragma once
 
 #include <cstdint>
@@ -6,6 +7,7 @@
 #include <vector>
 
 #include "swarmlio/common/status.h"
+#include "swarmlio/io/read_stats.h"
 
 namespace swarmlio::io {
 
@@ -25,9 +27,12 @@ struct BagInfo {
   int64_t start_time_ns = 0;         // bag time of the first message (0 if empty)
   int64_t end_time_ns = 0;           // bag time of the last message (0 if empty)
   std::vector<BagTopicInfo> topics;  // sorted by topic name
+  BagRecoveryStats recovery;         // set when the bag is truncated or unindexed
 };
 
-/// Reads the index of the bag at `path`.
-Status ReadBagInfo(const std::string& path, BagInfo* info);
+/// Reads the index of the bag at `path`. A truncated or unindexed bag is
+/// scanned instead (info->recovery says what was found and what was lost),
+/// unless `recover_damaged_bags` is false: then it is an error.
+Status ReadBagInfo(const std::string& path, BagInfo* info, bool recover_damaged_bags = true);
 
 }  // namespace swarmlio::io

@@ -16,34 +16,64 @@ namespace swarmlio::io {
 /// Chunk compression of a written bag.
 enum class BagCompression { kNone, kLz4, kBz2 };
 
+/// Topic option value (or "") that finds the topic by its message type.
+inline constexpr char kAutoTopic[] = "auto";
+
+/// True for "" and "auto" (for imu_topic / lidar_topic) or "auto" (for
+/// ground_truth_topic, where "" means none).
+inline bool IsAutoTopic(const std::string& topic) { return topic.empty() || topic == kAutoTopic; }
+
+/// Message type of written ground-truth poses.
+enum class GroundTruthFormat { kPoseStamped, kOdometry };
+
 struct BagReaderOptions {
-  std::string imu_topic = "/livox/imu";      // sensor_msgs/Imu; must exist
-  std::string lidar_topic = "/livox/lidar";  // PointCloud2 or Livox CustomMsg; must exist
-  std::string ground_truth_topic = "/ground_truth/pose";  // geometry_msgs/PoseStamped; optional
+  // Topics. IMU and LiDAR: "" or "auto" finds the topic by message type, and
+  // so does a configured topic that the bag lacks, when exactly one topic of
+  // the bag has a matching type (else the error lists the candidates).
+  // Ground truth: "" = none, "auto" = the only PoseStamped/Odometry topic; a
+  // configured ground-truth topic that the bag lacks means no ground truth
+  // (an odometry topic may be an estimate, so it is not taken silently).
+  std::string imu_topic = "/livox/imu";      // sensor_msgs/Imu; required
+  std::string lidar_topic = "/livox/lidar";  // PointCloud2 or Livox CustomMsg; required
+  std::string ground_truth_topic = "/ground_truth/pose";  // PoseStamped or Odometry; optional
   TimestampUnit point_time_unit = TimestampUnit::kMicrosecond;
   std::string point_time_field;          // "" = auto: "time", "t", "timestamp", "offset_time"
+  bool check_point_time_span = true;     // a per-point time span that cannot be a scan: error
   bool skip_malformed_messages = false;  // false: a malformed message is an error
   bool verify_chunks = true;             // check every chunk's records on open (one extra pass)
+  bool recover_damaged_bags = true;      // read truncated / unindexed bags by a record scan
   int max_message_mib = 512;             // larger messages are treated as corrupt [MiB]
 
   template <class Visitor>
   void VisitFields(Visitor&& v) {
-    v("imu_topic", imu_topic, config::FieldSpec::Doc("sensor_msgs/Imu topic (required)"));
+    v("imu_topic", imu_topic,
+      config::FieldSpec::Doc("sensor_msgs/Imu topic (required); \"\" or \"auto\" = the bag's only "
+                             "sensor_msgs/Imu topic, also used when the topic is absent"));
     v("lidar_topic", lidar_topic,
-      config::FieldSpec::Doc("sensor_msgs/PointCloud2 or livox_ros_driver/CustomMsg topic "
-                             "(required)"));
+      config::FieldSpec::Doc("sensor_msgs/PointCloud2 or livox_ros_driver(2)/CustomMsg topic "
+                             "(required); \"\" or \"auto\" = the bag's only such topic, also "
+                             "used when the topic is absent"));
     v("ground_truth_topic", ground_truth_topic,
-      config::FieldSpec::Doc("geometry_msgs/PoseStamped topic (optional, may be absent)"));
+      config::FieldSpec::Doc("geometry_msgs/PoseStamped or nav_msgs/Odometry topic (optional, may "
+                             "be absent); \"\" = none, \"auto\" = the bag's only such topic"));
     v("point_time_unit", point_time_unit,
       config::FieldSpec::Doc("unit of the PointCloud2 per-point time field"));
     v("point_time_field", point_time_field,
       config::FieldSpec::Doc("PointCloud2 per-point time field name; empty = auto-detect "
                              "time/t/timestamp/offset_time"));
+    v("check_point_time_span", check_point_time_span,
+      config::FieldSpec::Doc("fail when a scan's per-point times span far more (or, with a "
+                             "coarser unit fitting, far less) than the scan period in "
+                             "point_time_unit: a wrong unit"));
     v("skip_malformed_messages", skip_malformed_messages,
       config::FieldSpec::Doc("skip and count undecodable messages instead of failing"));
     v("verify_chunks", verify_chunks,
       config::FieldSpec::Doc("check every chunk's message records when opening (one extra "
                              "pass over the file); guards rosbag against corrupt bags"));
+    v("recover_damaged_bags", recover_damaged_bags,
+      config::FieldSpec::Doc("read a truncated or unindexed bag by scanning its records (every "
+                             "complete message before the damage; the rest is counted); false: "
+                             "such a bag is an error"));
     v("max_message_mib", max_message_mib,
       config::FieldSpec::InRange(1, 4096, "MiB", "larger messages are rejected as corrupt"));
   }
@@ -58,19 +88,21 @@ struct BagWriterOptions {
   LidarMessageFormat lidar_format = LidarMessageFormat::kLivoxCustomMsg;
   TimestampUnit point_time_unit = TimestampUnit::kMicrosecond;  // PointCloud2 only
   std::string point_time_field = "time";                        // PointCloud2 only
+  GroundTruthFormat ground_truth_format = GroundTruthFormat::kPoseStamped;
   BagCompression compression = BagCompression::kNone;
 
   template <class Visitor>
   void VisitFields(Visitor&& v) {
     v("imu_topic", imu_topic, config::FieldSpec::Doc("sensor_msgs/Imu topic"));
     v("lidar_topic", lidar_topic, config::FieldSpec::Doc("LiDAR topic"));
-    v("ground_truth_topic", ground_truth_topic,
-      config::FieldSpec::Doc("geometry_msgs/PoseStamped topic"));
+    v("ground_truth_topic", ground_truth_topic, config::FieldSpec::Doc("ground-truth topic"));
     v("lidar_format", lidar_format, config::FieldSpec::Doc("message type of LiDAR scans"));
     v("point_time_unit", point_time_unit,
       config::FieldSpec::Doc("unit of the written PointCloud2 time field"));
     v("point_time_field", point_time_field,
       config::FieldSpec::Doc("name of the written PointCloud2 time field"));
+    v("ground_truth_format", ground_truth_format,
+      config::FieldSpec::Doc("message type of ground-truth poses"));
     v("compression", compression, config::FieldSpec::Doc("bag chunk compression"));
   }
 
@@ -80,6 +112,14 @@ struct BagWriterOptions {
 }  // namespace swarmlio::io
 
 namespace swarmlio::config {
+
+template <>
+struct EnumTraits<io::GroundTruthFormat> {
+  static constexpr std::array<std::pair<io::GroundTruthFormat, const char*>, 2> kNames{{
+      {io::GroundTruthFormat::kPoseStamped, "pose_stamped"},
+      {io::GroundTruthFormat::kOdometry, "odometry"},
+  }};
+};
 
 template <>
 struct EnumTraits<io::BagCompression> {

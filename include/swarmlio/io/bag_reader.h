@@ -8,7 +8,15 @@
 // read_stats.h); a malformed message or a broken bag is an error Status.
 // Before rosbag sees the file its structure is checked (every length and
 // offset against the file size, and with options.verify_chunks every chunk's
-// records), so truncated or corrupt bags give an error, not a crash.
+// records), so corrupt bags give an error, not a crash. A truncated or
+// unindexed bag is read by scanning its records instead of rosbag's index
+// (options.recover_damaged_bags): every complete message before the damage,
+// the rest counted in stats().recovery.
+//
+// Topics left empty/"auto", or configured but absent from the bag, are found
+// by message type when the bag has exactly one candidate (see
+// BagReaderOptions); the resolved names are imu_topic(), lidar_topic() and
+// ground_truth_topic().
 //
 // ROS headers stay in src/io; this header needs none.
 #pragma once
@@ -39,10 +47,14 @@ struct BagRecord {
 /// Type of the LiDAR topic found in the bag.
 enum class LidarMessageType { kPointCloud2, kLivoxCustomMsg };
 
+/// Type of the ground-truth topic found in the bag.
+enum class GroundTruthMessageType { kPoseStamped, kOdometry };
+
 class BagReader {
  public:
-  /// Opens `path` and checks the configured topics: the IMU and LiDAR topics
-  /// must exist with a supported type, the ground-truth topic may be absent.
+  /// Opens `path` and resolves the topics: the IMU and LiDAR topics must
+  /// exist (or be found by type) with a supported type, the ground-truth
+  /// topic may be absent.
   static Status Open(const std::string& path,
                      const BagReaderOptions& options,
                      std::unique_ptr<BagReader>* reader);
@@ -59,7 +71,17 @@ class BagReader {
   const BagReaderOptions& options() const;
   const std::string& path() const;
   LidarMessageType lidar_message_type() const;
+  GroundTruthMessageType ground_truth_message_type() const;
   bool has_ground_truth() const;
+  /// The topics read (after discovery); ground_truth_topic() is "" without
+  /// ground truth.
+  const std::string& imu_topic() const;
+  const std::string& lidar_topic() const;
+  const std::string& ground_truth_topic() const;
+  /// Scan period used by the per-point time check [s]: the median spacing of
+  /// the LiDAR topic's bag times (0.1 s when it has fewer than 2 messages),
+  /// clamped to [1 ms, 1 s].
+  double scan_period_s() const;
   /// Bag (receive) time of the first and last message of the whole bag, as
   /// ReadBagInfo reports them (0 for an empty bag).
   int64_t start_time_ns() const;

@@ -2,7 +2,8 @@
 // readable by the ROS tools (rosbag info/play, rqt_bag) and by BagReader.
 //
 // IMU samples become sensor_msgs/Imu, ground-truth poses
-// geometry_msgs/PoseStamped, scans livox_ros_driver/CustomMsg or
+// geometry_msgs/PoseStamped or nav_msgs/Odometry
+// (BagWriterOptions::ground_truth_format), scans livox_ros_driver/CustomMsg or
 // sensor_msgs/PointCloud2 (BagWriterOptions::lidar_format). See
 // docs/bag_format.md for the exact layouts.
 #pragma once

@@ -57,8 +57,9 @@ struct SwarmOptions {
   double gate_sigma = 5.0;
   DegeneracyPolicy degeneracy_policy = DegeneracyPolicy::kFreezeExtrinsics;
   /// Observations that involve a teammate whose last message says its scan
-  /// was degenerate are not fused here (its pose is not to be trusted; the
-  /// degenerate drone itself still fuses them).
+  /// was degenerate are not fused while this drone's own last scan was not
+  /// degenerate (the teammate's pose is not to be trusted by a drone that
+  /// does not need it; a degenerate drone still fuses them).
   bool skip_degenerate_teammates = true;
   /// Radius of the ball around each tracked object kept out of the map [m].
   double map_exclusion_radius_m = 0.5;

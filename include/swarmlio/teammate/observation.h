@@ -34,8 +34,11 @@ struct ObservationOptions {
   double centroid_depth_offset_m = 0.07;   // centroid -> body origin along the line of sight [m]
   int min_reflective_points = 3;           // tape returns needed to average the tape only
   bool compensate_target_motion = true;    // move the centroid to the scan stamp
-  double range_sigma_m = 0.03;             // 1-sigma along the line of sight [m]
-  double lateral_sigma_m = 0.02;           // 1-sigma across it at zero range [m]
+  // Effective 1-sigma for fusion: twice the per-scan error seen in the
+  // harness (median 3 cm), because a cluster's error is correlated over
+  // several scans; tuned on indoor_3uav seed 1 (docs/swarm.md, "Tuning").
+  double range_sigma_m = 0.06;             // 1-sigma along the line of sight [m]
+  double lateral_sigma_m = 0.04;           // 1-sigma across it at zero range [m]
   double lateral_sigma_per_range_rad = 0.004;  // growth of the lateral 1-sigma per metre [rad]
   double min_range_m = 0.5;                // closer clusters give no observation [m]
 
