@@ -36,6 +36,19 @@ bool PositionAt(const eval::Trajectory& t, double stamp_s, Eigen::Vector3d* p) {
   return true;
 }
 
+// Start of the excitation flight from the ground truth: the first time the
+// horizontal speed exceeds 0.05 m/s (the plans hover, take off vertically,
+// then excite); NaN when unknown.
+double ExcitationStart(const eval::Trajectory& t) {
+  for (size_t k = 1; k < t.size(); ++k) {
+    const double dt = t.stamps_s[k] - t.stamps_s[k - 1];
+    if (dt <= 0.0) continue;
+    const Eigen::Vector3d v = (t.T_G_b[k].translation() - t.T_G_b[k - 1].translation()) / dt;
+    if (v.head<2>().norm() > 0.05) return t.stamps_s[k];
+  }
+  return std::nan("");
+}
+
 double RotationDeg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI; }
 
 }  // namespace
@@ -143,6 +156,16 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
         if (e.drone_id == j && !m.identified) {
           m.identified = true;
           m.identification_s = StampSeconds(e.stamp_ns) - t0;
+          const Eigen::Isometry3d T_true =
+              T_W_G(d.input()).inverse() * T_W_G(run.drone(j).input());
+          m.initial_error_m = (e.initial_T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm();
+          m.initial_error_deg =
+              RotationDeg(T_true.linear().transpose() * e.initial_T_Gi_Gj.R_Gi_Gj());
+          if (has_truth[i] && has_truth[j]) {
+            // Ground-truth stamps are in each drone's clock, like its bag.
+            m.since_excitation_s = StampSeconds(e.stamp_ns) -
+                                   std::max(ExcitationStart(truth[i]), ExcitationStart(truth[j]));
+          }
         }
       }
       if (m.relative_samples > 0) m.relative_rmse_m = std::sqrt(m.relative_rmse_m / m.relative_samples);
@@ -168,22 +191,34 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
     note(io::WritePcd((dir / "merged_map.pcd").string(), merged));
   }
   std::ostringstream md;
-  md << "| observer | teammate | identified [s] | extrinsic end [m / deg] | extrinsic max [m / deg] "
-        "| teammate rel. RMSE [m] | active / passive fused |\n|---|---|---|---|---|---|---|\n";
+  md << "| observer | teammate | identified [s] | after excitation start [s] | extrinsic end [m / deg] | extrinsic max [m / deg] "
+        "| teammate rel. RMSE [m] | active / passive fused |\n|---|---|---|---|---|---|---|---|\n";
   md << std::fixed;
   for (const PairMetrics& m : *pairs) {
     md << "| " << m.observer << " | " << m.teammate << " | ";
     if (!m.identified) {
-      md << "never | - | - | - | - |\n";
+      md << "never | - | - | - | - | - |\n";
       continue;
     }
-    md << std::setprecision(1) << m.identification_s << " | " << std::setprecision(3)
+    md << std::setprecision(1) << m.identification_s << " | " << m.since_excitation_s << " | "
+       << std::setprecision(3)
        << m.extrinsic_end_m << " / " << std::setprecision(2) << m.extrinsic_end_deg << " | "
        << std::setprecision(3) << m.extrinsic_max_m << " / " << std::setprecision(2)
        << m.extrinsic_max_deg << " | " << std::setprecision(3) << m.relative_rmse_m << " | "
        << m.active_fused << " / " << m.passive_fused << " |\n";
   }
   *markdown = md.str();
+  std::ofstream csv((dir / "swarm_pairs.csv").string());
+  csv << "observer,teammate,identified,identification_s,since_excitation_s,extrinsic_end_m,"
+         "extrinsic_end_deg,extrinsic_max_m,extrinsic_max_deg,relative_rmse_m,active_fused,"
+         "passive_fused,initial_error_m,initial_error_deg\n";
+  for (const PairMetrics& m : *pairs) {
+    csv << m.observer << "," << m.teammate << "," << (m.identified ? 1 : 0) << ","
+        << std::setprecision(6) << m.identification_s << "," << m.since_excitation_s << ","
+        << m.extrinsic_end_m << "," << m.extrinsic_end_deg << "," << m.extrinsic_max_m << ","
+        << m.extrinsic_max_deg << "," << m.relative_rmse_m << "," << m.active_fused << ","
+        << m.passive_fused << "," << m.initial_error_m << "," << m.initial_error_deg << "\n";
+  }
   std::ofstream mdfile((dir / "swarm.md").string());
   mdfile << *markdown;
   return first_error;

@@ -20,6 +20,9 @@ struct PairMetrics {
   std::string teammate;
   bool identified = false;
   double identification_s = 0.0;   // since the observer's first scan [s]
+  double since_excitation_s = 0.0; // since the later excitation start of the pair (truth) [s]
+  double initial_error_m = 0.0;    // T_Gi_Gj from the trajectory match vs truth [m]
+  double initial_error_deg = 0.0;  // ... [deg] (a wrong identification shows here)
   double extrinsic_end_m = 0.0;    // |p error| at the last scan [m]
   double extrinsic_end_deg = 0.0;  // rotation error at the last scan [deg]
   double extrinsic_max_m = 0.0;    // max over the scans after identification
