@@ -27,10 +27,16 @@ sed 's/arena: {size_m: \[10, 8, 4\]/arena: {size_m: [12, 9, 4]/' \
   "$ROOT/configs/scenarios/indoor_3uav.yaml" > "$OUT/variants/indoor_3uav_arena12x9.yaml"
 grep -q 'size_m: \[12, 9, 4\]' "$OUT/variants/indoor_3uav_arena12x9.yaml"
 
+# Other seeds: the scenario seed drives the excitation flights' random targets
+# (and the sensor noise), so it is set in a copy of the scenario file.
 runs=()
 for seed in $SEEDS; do
-  runs+=("indoor_3uav:$ROOT/configs/scenarios/indoor_3uav.yaml:$seed")
-  runs+=("decoys:$ROOT/configs/scenarios/decoys.yaml:$seed")
+  for name in indoor_3uav decoys; do
+    sed -E "0,/^  seed: [0-9]+/s//  seed: $seed/" "$ROOT/configs/scenarios/$name.yaml" \
+      > "$OUT/variants/$name.seed$seed.yaml"
+    grep -q "^  seed: $seed\$" "$OUT/variants/$name.seed$seed.yaml"
+    runs+=("$name:$OUT/variants/$name.seed$seed.yaml:$seed")
+  done
 done
 runs+=("indoor_3uav_arena12x9:$OUT/variants/indoor_3uav_arena12x9.yaml:1")
 
@@ -43,7 +49,7 @@ for run in "${runs[@]}"; do
   IFS=: read -r name scenario seed <<< "$run"
   dir="$OUT/$name.seed$seed"
   echo "== $name seed $seed" >&2
-  "$SIM" --scenario "$scenario" --seed "$seed" --output_dir "$dir/sim" > "$dir.sim.log" 2>&1
+  "$SIM" --scenario "$scenario" --output_dir "$dir/sim" > "$dir.sim.log" 2>&1
   "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/swarm" --save_maps=false \
     > "$dir.swarm.log" 2>&1 || true
   awk -F, -v name="$name" -v seed="$seed" 'NR > 1 {

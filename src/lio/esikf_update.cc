@@ -1,7 +1,6 @@
 #include "swarmlio/lio/esikf_update.h"
 
 #include <ceres/problem.h>
-#include <ceres/crs_matrix.h>
 #include <ceres/solver.h>
 
 #include <Eigen/Cholesky>
@@ -134,6 +133,71 @@ Status PlaneMeasurementModel::Linearize(const SwarmState& x, std::vector<Residua
   if (!correspondences_.empty()) terms->push_back({&factor_, {kEgoBlock}});
   return Status::Ok();
 }
+
+bool PlaneMeasurementModel::AddInformation(const SwarmState& x,
+                                           Eigen::MatrixXd* information) const {
+  Eigen::Matrix<double, 6, 6> HtH = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> Htz = Eigen::Matrix<double, 6, 1>::Zero();
+  factor_.AccumulateNormalEquations(x.ego, &HtH, &Htz);
+  static_assert(ErrorStateLayout::kRotation.offset == 0 && ErrorStateLayout::kPosition.offset == 3);
+  information->topLeftCorner<6, 6>() += HtH;
+  return true;
+}
+
+namespace {
+
+// J^T J of one residual block at the parameter values it points to: the
+// cost's ambient Jacobians times each block's PlusJacobian, placed at the
+// block's columns of the layout.
+bool AddTermInformation(const ResidualTerm& term, const std::vector<double*>& pointers,
+                        const ErrorStateLayout& layout, const ceres::Manifold& ego_manifold,
+                        const ceres::Manifold& teammate_manifold, Eigen::MatrixXd* information) {
+  const int m = term.cost->num_residuals();
+  const size_t nb = term.blocks.size();
+  std::vector<const double*> params(nb);
+  std::vector<int> offsets(nb), tangent(nb);
+  std::vector<const ceres::Manifold*> manifolds(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    const bool ego = term.blocks[b] == kEgoBlock;
+    params[b] = ego ? pointers[0] : pointers[static_cast<size_t>(layout.SlotOf(term.blocks[b])) + 1];
+    offsets[b] = ego ? 0 : layout.TeammateBlock(term.blocks[b]).offset;
+    manifolds[b] = ego ? &ego_manifold : &teammate_manifold;
+    tangent[b] = manifolds[b]->TangentSize();
+  }
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  std::vector<RowMajor> ambient(nb);
+  std::vector<double*> jacobians(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    ambient[b].resize(m, manifolds[b]->AmbientSize());
+    jacobians[b] = ambient[b].data();
+  }
+  Eigen::VectorXd residuals(m);
+  if (!term.cost->Evaluate(params.data(), residuals.data(), jacobians.data())) return false;
+  int cols = 0;
+  for (size_t b = 0; b < nb; ++b) cols += tangent[b];
+  Eigen::MatrixXd J(m, cols);
+  int c = 0;
+  for (size_t b = 0; b < nb; ++b) {
+    RowMajor plus(manifolds[b]->AmbientSize(), tangent[b]);
+    if (!manifolds[b]->PlusJacobian(params[b], plus.data())) return false;
+    J.middleCols(c, tangent[b]) = ambient[b] * plus;
+    c += tangent[b];
+  }
+  const Eigen::MatrixXd JtJ = J.transpose() * J;
+  int ci = 0;
+  for (size_t a = 0; a < nb; ++a) {
+    int cj = 0;
+    for (size_t b = 0; b < nb; ++b) {
+      information->block(offsets[a], offsets[b], tangent[a], tangent[b]) +=
+          JtJ.block(ci, cj, tangent[a], tangent[b]);
+      cj += tangent[b];
+    }
+    ci += tangent[a];
+  }
+  return true;
+}
+
+}  // namespace
 
 
 std::string EsikfUpdateOptions::Validate() const {
@@ -303,6 +367,7 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
   problem.AddResidualBlock(&prior, nullptr, pointers);
   std::vector<ceres::ResidualBlockId> measurement_blocks;
   std::vector<ResidualTerm> terms;
+  std::vector<size_t> model_terms;  // terms of model k: [model_terms[k], model_terms[k + 1])
   std::vector<double*> term_pointers;
 
   const ceres::Solver::Options solver_options = GaussNewtonSolverOptions(options_);
@@ -312,9 +377,11 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
     for (ceres::ResidualBlockId id : measurement_blocks) problem.RemoveResidualBlock(id);
     measurement_blocks.clear();
     terms.clear();
+    model_terms.assign(1, 0);
     const Clock::time_point t_assoc = Clock::now();
     for (MeasurementModel* model : models) {
       const Status status = model->Linearize(x, &terms);
+      model_terms.push_back(terms.size());
       if (!status.ok()) {
         result.association_time_s += SecondsSince(t_assoc);
         return fail(status.WithContext(std::string("EsikfUpdate: ") + model->name()));
@@ -365,28 +432,19 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
   }
 
   // Posterior (J^T J)^-1 at the final estimate: the tangent Jacobian of every
-  // residual block, columns in ErrorStateLayout order (the parameter blocks
-  // in layout order, each in its manifold's tangent space).
+  // residual block, columns in ErrorStateLayout order. The prior's in closed
+  // form; a model's through its fast path (AddInformation) when it has one,
+  // else from its blocks' Jacobians and the manifolds' PlusJacobian.
   const Clock::time_point t_cov = Clock::now();
   blocks.Write(x);
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks = pointers;
-  evaluate.apply_loss_function = false;
-  evaluate.num_threads = 1;
-  ceres::CRSMatrix crs;
-  if (!problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs) || crs.num_cols != x.Dim()) {
-    return fail(Status::Internal("EsikfUpdate: Jacobian evaluation failed"));
-  }
-  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(x.Dim(), x.Dim());
-  for (int r = 0; r < crs.num_rows; ++r) {
-    const int begin = crs.rows[static_cast<size_t>(r)];
-    const int end = crs.rows[static_cast<size_t>(r) + 1];
-    for (int a = begin; a < end; ++a) {
-      const double va = crs.values[static_cast<size_t>(a)];
-      if (va == 0.0) continue;  // point rows: 6 of 18 ego columns are non-zero
-      const int ca = crs.cols[static_cast<size_t>(a)];
-      for (int b = begin; b < end; ++b) {
-        information(ca, crs.cols[static_cast<size_t>(b)]) += va * crs.values[static_cast<size_t>(b)];
+  const Eigen::MatrixXd J_prior = prior.TangentJacobian(x);
+  Eigen::MatrixXd information = J_prior.transpose() * J_prior;
+  for (size_t k = 0; k < models.size(); ++k) {
+    if (models[k]->AddInformation(x, &information)) continue;
+    for (size_t t = model_terms[k]; t < model_terms[k + 1]; ++t) {
+      if (!AddTermInformation(terms[t], pointers, x.layout(), ego_manifold, teammate_manifold,
+                              &information)) {
+        return fail(Status::Internal("EsikfUpdate: Jacobian evaluation failed"));
       }
     }
   }

@@ -48,7 +48,8 @@ Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord
   if (!out) return Status::IoError(path + ": cannot open for writing");
   out << "stamp_s,updated,raw_points,points,correspondences,iterations,min_normal_information,"
          "degenerate,map_points,preprocess_ms,propagate_ms,undistort_ms,association_ms,solve_ms,"
-         "covariance_ms,map_update_ms,total_ms\n";
+         "covariance_ms,map_update_ms,total_ms,front_end_ms,active_fused,passive_fused,"
+         "rejected_observations,extrinsics_frozen\n";
   out << std::fixed;
   for (const replay::ScanRecord& s : scans) {
     const lio::ScanTimings& t = s.timings;
@@ -58,7 +59,9 @@ Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord
         << (s.degenerate ? 1 : 0) << "," << s.map_size << std::setprecision(4) << ","
         << 1e3 * t.preprocess_s << "," << 1e3 * t.propagate_s << "," << 1e3 * t.undistort_s << ","
         << 1e3 * t.association_s << "," << 1e3 * t.solve_s << "," << 1e3 * t.covariance_s << ","
-        << 1e3 * t.map_update_s << "," << 1e3 * t.total_s << "\n";
+        << 1e3 * t.map_update_s << "," << 1e3 * t.total_s << "," << 1e3 * t.front_end_s << ","
+        << s.active_observations << "," << s.passive_observations << ","
+        << s.rejected_observations << "," << (s.extrinsics_frozen ? 1 : 0) << "\n";
   }
   return out ? Status::Ok() : Status::IoError(path + ": write failed");
 }

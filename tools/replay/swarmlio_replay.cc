@@ -88,6 +88,7 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     const StageStats stages[] = {{"preprocess", &lio::ScanTimings::preprocess_s},
                                  {"propagate", &lio::ScanTimings::propagate_s},
                                  {"undistort", &lio::ScanTimings::undistort_s},
+                                 {"front end", &lio::ScanTimings::front_end_s},
                                  {"association", &lio::ScanTimings::association_s},
                                  {"solve", &lio::ScanTimings::solve_s},
                                  {"covariance", &lio::ScanTimings::covariance_s},

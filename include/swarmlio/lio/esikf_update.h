@@ -133,6 +133,8 @@ class PlaneMeasurementModel final : public MeasurementModel {
   explicit PlaneMeasurementModel(PlaneAssociationFn associate);
   const char* name() const override { return "point_to_plane"; }
   Status Linearize(const SwarmState& x, std::vector<ResidualTerm>* terms) override;
+  /// H^T H of the point rows (6x6 over rotation and position, closed form).
+  bool AddInformation(const SwarmState& x, Eigen::MatrixXd* information) const override;
   const std::vector<PlaneCorrespondence>& correspondences() const { return correspondences_; }
 
  private:

@@ -17,6 +17,8 @@
 
 #include <ceres/cost_function.h>
 
+#include <Eigen/Core>
+
 #include <vector>
 
 #include "swarmlio/common/status.h"
@@ -43,6 +45,16 @@ class MeasurementModel {
   /// `*terms` (none is fine: e.g. no plane found). Blocks may name only
   /// teammates present in x's layout. A non-ok Status aborts the update.
   virtual Status Linearize(const SwarmState& x, std::vector<ResidualTerm>* terms) = 0;
+  /// Optional fast path for the posterior covariance: adds J^T J of the
+  /// residual blocks of the last Linearize, evaluated at `x`, in the tangent
+  /// space and ErrorStateLayout order of x, to `*information` and returns
+  /// true. The default returns false and the update evaluates the blocks
+  /// itself (cost Jacobians times the manifolds' PlusJacobian).
+  virtual bool AddInformation(const SwarmState& x, Eigen::MatrixXd* information) const {
+    (void)x;
+    (void)information;
+    return false;
+  }
 };
 
 }  // namespace swarmlio
