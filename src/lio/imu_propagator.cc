@@ -311,7 +311,10 @@ void ImuPropagator::PropagateCovariance(const EgoMatrix& F, const EgoNoiseMatrix
     P_.block<3, 3>(trans.offset, trans.offset).diagonal().array() +=
         dt2 * options_.process_noise.teammate_translation_cov_m2_s2;
   }
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  // Only the ego rows and columns changed: symmetrize those (O(18 n), not O(n^2)).
+  const Eigen::MatrixXd ego_rows = 0.5 * (P_.topRows(kEgo) + P_.leftCols(kEgo).transpose());
+  P_.topRows(kEgo) = ego_rows;
+  P_.leftCols(kEgo) = ego_rows.transpose();
 }
 
 }  // namespace swarmlio

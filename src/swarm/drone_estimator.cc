@@ -139,8 +139,30 @@ struct SwarmPart {
 
 }  // namespace
 
+// A teammate's T_Gj_Gi (it identified this drone), waiting for the next scan.
+struct PendingMutual {
+  net::GlobalExtrinsicEntry entry;  // entry.teammate_id == this drone
+};
+
+// T_Gi_Gj = T_Gj_Gi^-1 with the covariance mapped to the inverse's error
+// state (R Exp(theta), p + dp): theta' = -R theta, dp' = [p']x theta - R^T dp.
+void InvertExtrinsic(const net::GlobalExtrinsicEntry& e, GlobalExtrinsic* T,
+                     Eigen::Matrix<double, 6, 6>* C) {
+  const Eigen::Matrix3d R = e.q_Gi_Gj.normalized().toRotationMatrix();
+  T->q_Gi_Gj = e.q_Gi_Gj.normalized().conjugate();
+  T->p_Gj_in_Gi = -(R.transpose() * e.p_Gj_in_Gi);
+  Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+  J.topLeftCorner<3, 3>() = -R;
+  J.bottomLeftCorner<3, 3>() = so3::Hat(T->p_Gj_in_Gi);
+  J.bottomRightCorner<3, 3>() = -R.transpose();
+  *C = J * e.covariance * J.transpose();
+}
+
 struct DroneEstimator::Impl {
   std::map<int, TeammateInfo> teammates;
+  std::map<int, PendingMutual> mutual;  // by sender
+  int64_t last_extrinsic_broadcast_ns = 0;
+  bool broadcast_extrinsics_once = false;
   std::deque<PendingPassive> passive;
   MutualObservationModel model;
   std::vector<UndistortedPoint> undistorted;
@@ -243,6 +265,21 @@ void DroneEstimator::PopMessages(std::vector<net::SwarmMessage>* messages) {
 
 Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   ++counters_.messages_received;
+  if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&received.message)) {
+    if (g->sender_id == self_id_ || g->sender_id < 0) {
+      ++counters_.messages_ignored;
+      return Status::Ok();
+    }
+    for (const net::GlobalExtrinsicEntry& e : g->entries) {
+      if (e.teammate_id != self_id_) continue;
+      if (!e.q_Gi_Gj.coeffs().allFinite() || !e.p_Gj_in_Gi.allFinite() ||
+          !e.covariance.allFinite()) {
+        continue;
+      }
+      impl_->mutual[g->sender_id] = PendingMutual{e};
+    }
+    return Status::Ok();
+  }
   const auto* m = std::get_if<net::EgoStateMessage>(&received.message);
   if (m == nullptr || m->sender_id == self_id_ || m->sender_id < 0 || !Finite(*m)) {
     ++counters_.messages_ignored;
@@ -250,9 +287,18 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   }
   TeammateInfo& info = impl_->teammates[m->sender_id];
   if (info.have_message && m->session_start_ns != info.session_start_ns) {
+    // j rebooted: its G_j is new. Its old track and trajectory are useless;
+    // its state block goes at the next scan; it is identified again.
     ++counters_.teammate_restarts;
     info.restarted = true;
     info.have_message = false;
+    detector_->ForgetTeammate(m->sender_id);
+    impl_->mutual.erase(m->sender_id);
+    impl_->passive.erase(std::remove_if(impl_->passive.begin(), impl_->passive.end(),
+                                        [&](const PendingPassive& p) {
+                                          return p.from == m->sender_id;
+                                        }),
+                         impl_->passive.end());
   }
   if (info.have_message && m->stamp_ns <= info.last.stamp_ns) {
     ++counters_.messages_ignored;  // older than what we have (reordered)
@@ -269,6 +315,7 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   odometry.p_bj_in_Gj = m->p_bj_in_Gj;
   odometry.q_Gj_bj = m->q_Gj_bj.normalized();
   odometry.v_bj_in_Gj = m->v_bj_in_Gj;
+  odometry.degenerate = m->degenerated;
   detector_->AddTeammateOdometry(odometry);
 
   for (const net::TeammateObservation& o : m->observations) {
@@ -347,6 +394,34 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
     im.part.identifications.push_back(event);
     ++counters_.identifications;
   }
+  // Mutual identification: j matched this drone's trajectory and sent T_Gj_Gi.
+  if (so.mutual_identification) {
+    for (const auto& [j, pending] : im.mutual) {
+      if (x->HasTeammate(j) || im.teammates[j].restarted) continue;
+      GlobalExtrinsic T;
+      Eigen::Matrix<double, 6, 6> C;
+      InvertExtrinsic(pending.entry, &T, &C);
+      if (!detector_->AddIdentifiedTeammate(j, Seconds(t_k), T.R_Gi_Gj(), T.p_Gj_in_Gi)) continue;
+      // At least the covariance of an own match with zero residual.
+      C = 0.5 * (C + C.transpose());
+      for (int k = 0; k < 3; ++k) {
+        C(k, k) = std::max(C(k, k), so.init_rotation_sigma_floor_rad * so.init_rotation_sigma_floor_rad);
+        C(3 + k, 3 + k) = std::max(C(3 + k, 3 + k), so.init_translation_sigma_floor_m *
+                                                         so.init_translation_sigma_floor_m);
+      }
+      x->AddTeammate(j, T);
+      AppendCovarianceBlock(C, P);
+      im.teammates[j].last_seen_ns = t_k;
+      IdentificationEvent event;
+      event.drone_id = j;
+      event.stamp_ns = t_k;
+      event.method = "teammate_match";
+      event.initial_T_Gi_Gj = T;
+      im.part.identifications.push_back(event);
+      ++counters_.identifications;
+    }
+  }
+  im.mutual.clear();
   for (const teammate::TeammateObservation& o : im.detection.observations) {
     im.teammates[o.drone_id].last_seen_ns = t_k;
   }
@@ -358,6 +433,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
     if (!lost && !info.restarted) continue;
     EraseCovarianceBlock(x->layout().TeammateBlock(id), P);
     x->RemoveTeammate(id);
+    if (lost) detector_->ForgetTeammate(id);
     info.restarted = false;
     im.part.removed.push_back(id);
     ++counters_.teammates_removed;
@@ -521,6 +597,34 @@ void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState&
   }
   im.detection.observations.clear();
   if (m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite()) im.messages.push_back(m);
+
+  // The own T_Gi_Gj estimates, every extrinsic_broadcast_period_s and right
+  // after a new identification (teammates use them to identify this drone).
+  const double period = options_.swarm.extrinsic_broadcast_period_s;
+  const bool new_block = !im.parts.back().identifications.empty();
+  if (period > 0.0 && x.layout().NumTeammates() > 0 &&
+      (new_block || !im.broadcast_extrinsics_once ||
+       Seconds(t_k - im.last_extrinsic_broadcast_ns) >= period)) {
+    std::vector<net::GlobalExtrinsicEntry> entries;
+    for (int id : x.layout().teammate_ids()) {
+      net::GlobalExtrinsicEntry e;
+      e.teammate_id = id;
+      e.source = net::ExtrinsicSource::kTrajectoryMatch;
+      e.q_Gi_Gj = x.teammate(id).q_Gi_Gj.normalized();
+      e.p_Gj_in_Gi = x.teammate(id).p_Gj_in_Gi;
+      const Segment b = x.layout().TeammateBlock(id);
+      e.covariance = P.block<6, 6>(b.offset, b.offset);
+      e.covariance = 0.5 * (e.covariance + e.covariance.transpose()).eval();
+      if (e.q_Gi_Gj.coeffs().allFinite() && e.p_Gj_in_Gi.allFinite() && e.covariance.allFinite()) {
+        entries.push_back(e);
+      }
+    }
+    for (net::GlobalExtrinsicMessage& g : net::SplitGlobalExtrinsics(self_id_, t_k, entries)) {
+      im.messages.push_back(std::move(g));
+    }
+    im.last_extrinsic_broadcast_ns = t_k;
+    im.broadcast_extrinsics_once = true;
+  }
 }
 
 }  // namespace swarmlio::swarm

@@ -319,4 +319,29 @@ bool TeammateDetector::SetGlobalExtrinsic(int drone_id, const Eigen::Isometry3d&
   return true;
 }
 
+bool TeammateDetector::AddIdentifiedTeammate(int drone_id, double stamp_s,
+                                             const Eigen::Matrix3d& R_Gi_Gj,
+                                             const Eigen::Vector3d& p_Gj_in_Gi) {
+  if (teammates_.count(drone_id) > 0) return false;
+  const auto it = odometry_.find(drone_id);
+  if (it == odometry_.end()) return false;
+  const TeammateTrackerOptions& o = options_.teammate;
+  Eigen::Vector3d p_bj_in_Gj, v_bj_in_Gj;
+  if (!it->second.StateAt(stamp_s, o.max_odometry_age_s, o.max_odometry_age_s, &p_bj_in_Gj,
+                          &v_bj_in_Gj)) {
+    return false;
+  }
+  ConstantVelocityFilter filter;
+  filter.Initialize(stamp_s, R_Gi_Gj * p_bj_in_Gj + p_Gj_in_Gi, R_Gi_Gj * v_bj_in_Gj,
+                    o.odometry_position_sigma_m, o.velocity_sigma_m_s);
+  teammates_.emplace(drone_id,
+                     TeammateTracker(drone_id, next_tracker_id_++, R_Gi_Gj, p_Gj_in_Gi, filter));
+  return true;
+}
+
+bool TeammateDetector::ForgetTeammate(int drone_id) {
+  const bool known = teammates_.erase(drone_id) > 0;
+  return odometry_.erase(drone_id) > 0 || known;
+}
+
 }  // namespace swarmlio::teammate

@@ -13,9 +13,22 @@ TeammateTracker::TeammateTracker(int drone_id, int tracker_id, const Eigen::Matr
       p_Gj_in_Gi_(p_Gj_in_Gi),
       filter_(filter) {}
 
+namespace {
+
+// j's newest broadcast says its LiDAR is degenerate: do not use its odometry.
+bool ReportsDegeneracy(const OdometryHistory& history) {
+  return !history.empty() && history.newest().degenerate;
+}
+
+}  // namespace
+
 bool TeammateTracker::VelocityInGi(double stamp_s, const OdometryHistory& history,
                                    const TeammateTrackerOptions& options,
                                    Eigen::Vector3d* v_in_Gi) const {
+  if (ReportsDegeneracy(history)) {
+    *v_in_Gi = filter_.v();
+    return true;
+  }
   if (history.empty() || stamp_s - history.newest().stamp_s > options.disconnect_s) return false;
   Eigen::Vector3d p_bj_in_Gj, v_bj_in_Gj;
   if (!history.StateAt(stamp_s, options.max_odometry_age_s, options.max_odometry_age_s,
@@ -28,6 +41,10 @@ bool TeammateTracker::VelocityInGi(double stamp_s, const OdometryHistory& histor
 
 void TeammateTracker::Predict(double stamp_s, const OdometryHistory& history,
                               const TeammateTrackerOptions& options) {
+  if (ReportsDegeneracy(history)) {
+    filter_.PredictTo(stamp_s, options.degenerate_accel_noise_m_s2_sqrt_hz);
+    return;
+  }
   Eigen::Vector3d v_in_Gi;
   if (!VelocityInGi(stamp_s, history, options, &v_in_Gi)) v_in_Gi.setZero();
   filter_.PredictWithVelocity(stamp_s, v_in_Gi, options.velocity_sigma_m_s);
@@ -52,6 +69,7 @@ void TeammateTracker::UpdateLidar(double stamp_s, const Eigen::Vector3d& p_in_Gi
 bool TeammateTracker::UpdateOdometry(double stamp_s, const OdometryHistory& history,
                                      const TeammateTrackerOptions& options) {
   Predict(stamp_s, history, options);
+  if (ReportsDegeneracy(history)) return false;
   Eigen::Vector3d p_bj_in_Gj;
   if (!history.StateAt(stamp_s, options.max_odometry_age_s, options.max_odometry_age_s,
                        &p_bj_in_Gj, nullptr)) {

@@ -61,6 +61,12 @@ struct SwarmOptions {
   /// degenerate (the teammate's pose is not to be trusted by a drone that
   /// does not need it; a degenerate drone still fuses them).
   bool skip_degenerate_teammates = true;
+  /// A teammate j that identified this drone (and sent its T_Gj_Gi) is
+  /// added here with the inverse, without waiting for an own match
+  /// (docs/swarm.md "Mutual identification").
+  bool mutual_identification = true;
+  /// The own T_Gi_Gj estimates are broadcast this often (0 = never) [s].
+  double extrinsic_broadcast_period_s = 1.0;
   /// Radius of the ball around each tracked object kept out of the map [m].
   double map_exclusion_radius_m = 0.5;
 
@@ -86,6 +92,10 @@ struct SwarmOptions {
       FieldSpec::Doc("freeze_extrinsics | estimate_all, after a degenerate scan"));
     v("skip_degenerate_teammates", skip_degenerate_teammates,
       FieldSpec::Doc("do not fuse observations involving a teammate that reports degeneracy"));
+    v("mutual_identification", mutual_identification,
+      FieldSpec::Doc("add a teammate that identified this drone, with the inverse of its T_Gj_Gi"));
+    v("extrinsic_broadcast_period_s", extrinsic_broadcast_period_s,
+      FieldSpec::AtLeast(0.0, "s", "broadcast the own T_Gi_Gj estimates this often (0 = never)"));
     v("map_exclusion_radius_m", map_exclusion_radius_m,
       FieldSpec::Positive("m", "points this close to a tracked object stay out of the map"));
   }

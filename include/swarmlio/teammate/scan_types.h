@@ -45,6 +45,9 @@ struct TeammateOdometry {
   Eigen::Vector3d p_bj_in_Gj = Eigen::Vector3d::Zero();   // [m]
   Eigen::Quaterniond q_Gj_bj = Eigen::Quaterniond::Identity();
   Eigen::Vector3d v_bj_in_Gj = Eigen::Vector3d::Zero();   // [m/s]
+  /// The sender's last scan was LiDAR-degenerate: its odometry may drift, so
+  /// its tracker predicts from the LiDAR track instead (teammate_tracker.h).
+  bool degenerate = false;
 };
 
 }  // namespace swarmlio::teammate

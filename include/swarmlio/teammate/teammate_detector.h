@@ -105,6 +105,17 @@ class TeammateDetector {
   bool GlobalExtrinsic(int drone_id, Eigen::Isometry3d* T_Gi_Gj) const;
   /// Replaces T_Gi_Gj with a refined estimate (from the ESIKF); false if not identified.
   bool SetGlobalExtrinsic(int drone_id, const Eigen::Isometry3d& T_Gi_Gj);
+  /// Starts tracking a teammate identified elsewhere (the teammate matched
+  /// this drone's trajectory and sent its T_Gj_Gi; docs/swarm.md "Mutual
+  /// identification"): a teammate tracker at its broadcast position mapped
+  /// through T_Gi_Gj. False when already tracked or when no broadcast of it
+  /// is close enough to `stamp_s`.
+  bool AddIdentifiedTeammate(int drone_id, double stamp_s, const Eigen::Matrix3d& R_Gi_Gj,
+                             const Eigen::Vector3d& p_Gj_in_Gi);
+  /// Forgets a teammate (its tracker and broadcast history), e.g. after it
+  /// rebooted (new global frame) or was lost for good; it can be identified
+  /// again from new broadcasts. False if nothing was known of it.
+  bool ForgetTeammate(int drone_id);
 
   int num_temporary_trackers() const { return static_cast<int>(temporary_.size()); }
   const std::vector<TemporaryTracker>& temporary_trackers() const { return temporary_; }

@@ -2,7 +2,10 @@
 // in G_i with the constant-velocity filter, but
 //  - predicted with the velocity j broadcasts, rotated by R_Gi_Gj;
 //  - updated from a LiDAR cluster when j is seen, otherwise from j's
-//    broadcast position mapped through the global extrinsic T_Gi_Gj.
+//    broadcast position mapped through the global extrinsic T_Gi_Gj;
+//  - except while j reports its LiDAR degenerate (its odometry drifts): then
+//    the filter runs on its own constant-velocity model and LiDAR updates
+//    only, so that a drifting broadcast cannot pull the track off the drone.
 // Swarm-LIO2 trusts the broadcast odometry more than the cluster for this
 // filter (0.001 vs 0.01 m^2); the filter only predicts where to look, the
 // observation output is the cluster itself (observation.h).
@@ -24,6 +27,7 @@ struct TeammateTrackerOptions {
   double velocity_sigma_m_s = 0.1;          // 1-sigma of the broadcast velocity in prediction
   double max_odometry_age_s = 0.5;          // older broadcasts are not used to update
   double disconnect_s = 2.0;                // no message for this long: the tracker holds still
+  double degenerate_accel_noise_m_s2_sqrt_hz = 2.0;  // CV model while j reports degeneracy
 
   template <class V>
   void VisitFields(V&& v) {
@@ -38,6 +42,9 @@ struct TeammateTrackerOptions {
       FieldSpec::Positive("s", "broadcast older than this is stale (not used to update)"));
     v("disconnect_s", disconnect_s,
       FieldSpec::Positive("s", "no broadcast for this long: prediction stops"));
+    v("degenerate_accel_noise_m_s2_sqrt_hz", degenerate_accel_noise_m_s2_sqrt_hz,
+      FieldSpec::Positive("m/s^2/sqrt(Hz)",
+                          "constant-velocity model noise while the teammate reports degeneracy"));
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };
