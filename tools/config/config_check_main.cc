@@ -20,6 +20,7 @@
 #include "swarmlio/net/network_options.h"
 #include "swarmlio/sensors/imu_options.h"
 #include "swarmlio/sensors/lidar_options.h"
+#include "swarmlio/swarm/swarm_options.h"
 #include "swarmlio/teammate/teammate_detector_options.h"
 
 DEFINE_string(config, "", "YAML config file to check (or pass it as the only argument)");
@@ -60,6 +61,7 @@ std::vector<Section> Sections() {
       MakeSection<swarmlio::ImuOptions>("imu"),
       MakeSection<swarmlio::teammate::TeammateDetectorOptions>("teammate"),
       MakeSection<swarmlio::lio::OdometryOptions>("odometry"),
+      MakeSection<swarmlio::swarm::SwarmOptions>("swarm"),
       MakeSection<swarmlio::net::NetworkOptions>("network"),
   };
 }
