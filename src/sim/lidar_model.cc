@@ -4,10 +4,74 @@
 #include <cmath>
 
 #include "swarmlio/common/check.h"
+#include "swarmlio/sim/random.h"
 #include "swarmlio/sim/reflectivity.h"
 
 namespace swarmlio::sim {
 namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+// Sub-streams of a LidarModel's seed for the imperfections (the base stream is
+// the seed itself, as it always was).
+constexpr uint64_t kImperfectionStream = 1;
+constexpr uint64_t kSecondReturnStream = 2;
+// Counter-based draws of one pulse (CounterUniform(key, pulse, draw)).
+enum PulseDraw : uint64_t {
+  kAngularNoise = 0,  // and 1: a Box-Muller pair
+  kRangeDropout = 2,
+  kMixDecision = 3,
+  kMixWeight = 4,
+  kProbeRadius = 5,
+  kProbeAngle = 6,
+  kSecondReturnNoise = 7,  // and 8
+};
+
+// Two independent N(0, 1) numbers from draws `first` and `first + 1` (Box-Muller).
+void NormalPair(uint64_t key, uint64_t pulse, uint64_t first, double* a, double* b) {
+  const double radius = std::sqrt(-2.0 * std::log(CounterUniform(key, pulse, first)));
+  const double angle = 2.0 * M_PI * CounterUniform(key, pulse, first + 1);
+  *a = radius * std::cos(angle);
+  *b = radius * std::sin(angle);
+}
+// The incidence term of the range noise stops growing at 85 deg.
+const double kMinCosIncidence = std::cos(85.0 * kDeg);
+constexpr uint8_t kFirstReturn = 0x10;   // Livox tag bits 5:4 = 01
+constexpr uint8_t kSecondReturn = 0x20;  // Livox tag bits 5:4 = 10
+
+// Unit vectors normal to the beam `d` (LiDAR frame): h in the x-y plane, v =
+// d x h (towards +z for a horizontal beam).
+void FootprintAxes(const Eigen::Vector3d& d, Eigen::Vector3d* h, Eigen::Vector3d* v) {
+  Eigen::Vector3d a = Eigen::Vector3d::UnitZ().cross(d);
+  if (a.squaredNorm() < 1e-12) a = Eigen::Vector3d::UnitY();  // a beam along z
+  *h = a.normalized();
+  *v = d.cross(*h);
+}
+
+// Measured range of a return from true range `r` (see LidarImperfectionOptions).
+double MeasuredRange(const LidarOptions& sensor,
+                     const LidarImperfectionOptions& imp,
+                     double divergence_rms_rad,
+                     double r,
+                     double cos_incidence,
+                     double reflectivity,
+                     double unit_normal_draw) {
+  double sigma = sensor.range_noise_stddev_m;
+  if (imp.range_noise_per_m > 0.0 || imp.incidence_noise) {
+    double variance = sigma * sigma + std::pow(imp.range_noise_per_m * r, 2);
+    if (imp.incidence_noise) {
+      const double c = std::clamp(cos_incidence, kMinCosIncidence, 1.0);
+      const double spread = r * divergence_rms_rad * std::sqrt(1.0 - c * c) / c / 4.0;
+      variance += spread * spread;
+    }
+    sigma = std::sqrt(variance);
+  }
+  double range = r;
+  if (imp.low_reflectivity_bias_m != 0.0) {
+    range += imp.low_reflectivity_bias_m *
+             std::max(0.0, 1.0 - reflectivity / imp.low_reflectivity_threshold);
+  }
+  return range + sigma * unit_normal_draw;
+}
 
 // Conservative test whether the ray passes within `radius` of `center` before `t_max`.
 bool RayNearSphere(const Ray& ray, const Eigen::Vector3d& center, double radius, double t_max) {
@@ -19,9 +83,12 @@ bool RayNearSphere(const Ray& ray, const Eigen::Vector3d& center, double radius,
 
 }  // namespace
 
-LidarModel::LidarModel(const SimulatedLidarOptions& options, const Trajectory* own_trajectory,
-                       const Scene* scene, const std::vector<MovingObject>* objects,
-                       int own_object, uint64_t seed)
+LidarModel::LidarModel(const SimulatedLidarOptions& options,
+                       const Trajectory* own_trajectory,
+                       const Scene* scene,
+                       const std::vector<MovingObject>* objects,
+                       int own_object,
+                       uint64_t seed)
     : options_(options),
       pattern_(options.sensor),
       own_trajectory_(own_trajectory),
@@ -31,7 +98,9 @@ LidarModel::LidarModel(const SimulatedLidarOptions& options, const Trajectory* o
       t0_(options.start_time_s),
       period_(1.0 / options.sensor.scan_rate_hz),
       R_imu_lidar_(options.sensor.QuaternionImuLidar().toRotationMatrix()),
-      rng_(seed) {
+      rng_(seed),
+      imperfection_key_(DeriveSeed(seed, 0, kImperfectionStream)),
+      second_return_rng_(DeriveSeed(seed, 0, kSecondReturnStream)) {
   CHECK(options_.Validate().empty()) << options_.Validate();
   CHECK(own_trajectory_ != nullptr && scene_ != nullptr);
   CHECK(scene_->built());
@@ -79,6 +148,13 @@ void LidarModel::Scan(int64_t frame, SimulatedScan* scan) {
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   std::normal_distribution<double> normal;
   const LidarOptions& sensor = options_.sensor;
+  const LidarImperfectionOptions& imp = options_.imperfections;
+  const double angular_sigma = imp.angular_noise_deg * kDeg;
+  const double half_divergence_h = 0.5 * imp.beam_divergence_horizontal_deg * kDeg;
+  const double half_divergence_v = 0.5 * imp.beam_divergence_vertical_deg * kDeg;
+  const double divergence_rms = std::sqrt(
+      2.0 * (half_divergence_h * half_divergence_h + half_divergence_v * half_divergence_v));
+  const bool needs_axes = angular_sigma > 0.0 || imp.SamplesFootprint();
   const int64_t first_pulse = frame * pulses_per_frame;
   const double max_range = sensor.max_range_m;
   for (int64_t i = 0; i < pulses_per_frame; ++i) {
@@ -88,48 +164,122 @@ void LidarModel::Scan(int64_t frame, SimulatedScan* scan) {
     uint8_t line;
     pattern_.Direction(k, &dir_l, &line);
     const Pose T_W_l = LidarPoseAt(t);
-    const Ray ray{T_W_l.p_b_in_W, T_W_l.R_W_b * dir_l};
 
-    RayHit best;
-    int best_object = -1;
-    const Material* material = nullptr;
-    if (scene_->Intersect(ray, 0.0, max_range, &best)) {
-      material = &scene_->primitives()[best.primitive].material();
+    // Imperfections: counter-based draws (a pure function of the pulse), so
+    // each effect sees the same numbers whatever else is enabled.
+    const uint64_t pulse = static_cast<uint64_t>(k);
+    Eigen::Vector3d beam_l = dir_l;  // where the pulse really goes
+    Eigen::Vector3d axis_h = Eigen::Vector3d::Zero(), axis_v = Eigen::Vector3d::Zero();
+    if (needs_axes) FootprintAxes(dir_l, &axis_h, &axis_v);
+    if (angular_sigma > 0.0) {
+      double n_h, n_v;
+      NormalPair(imperfection_key_, pulse, kAngularNoise, &n_h, &n_v);
+      beam_l = (dir_l + angular_sigma * (n_h * axis_h + n_v * axis_v)).normalized();
     }
-    for (const Candidate& c : candidates_) {
-      if (!RayNearSphere(ray, c.center, c.radius, best.hit() ? best.t : max_range)) continue;
-      const MovingObject& obj = (*objects_)[c.object];
-      const Pose T_W_o = obj.trajectory->PoseAt(t);
-      // The ray in the object's body frame.
-      const Ray ray_o{T_W_o.R_W_b.transpose() * (ray.origin - T_W_o.p_b_in_W),
-                      T_W_o.R_W_b.transpose() * ray.direction};
-      RayHit hit_o;
-      if (IntersectBruteForce(obj.parts_b, ray_o, 0.0, best.hit() ? best.t : max_range,
-                              &hit_o)) {
-        best = hit_o;
-        best.normal = T_W_o.R_W_b * hit_o.normal;
-        best_object = c.object;
-        material = &obj.parts_b[hit_o.primitive].material();
-      }
-    }
+    const Ray ray{T_W_l.p_b_in_W, T_W_l.R_W_b * beam_l};
+    const Hit main = Cast(ray, t);
     // Draw the random numbers for every pulse so that the stream does not
     // depend on the geometry hit.
     const double dropout_draw = uniform(rng_);
     const double range_draw = normal(rng_);
-    if (!best.hit() || best.t < sensor.blind_range_m) continue;
+    if (!main.hit.hit() || main.hit.t < sensor.blind_range_m) continue;
     if (dropout_draw < options_.dropout_probability) continue;
+    if (imp.range_dropout_at_max_range > 0.0) {
+      const double loss =
+          imp.range_dropout_at_max_range *
+          std::pow(std::min(1.0, main.hit.t / max_range), imp.range_dropout_exponent);
+      if (CounterUniform(imperfection_key_, pulse, kRangeDropout) <= loss) continue;
+    }
     SimulatedPoint p;
     p.t_s = t;
-    p.true_range_m = best.t;
-    const double range = best.t + sensor.range_noise_stddev_m * range_draw;
-    p.p_in_lidar = dir_l * range;
-    p.reflectivity = Reflectivity(options_.reflectivity, *material, best.t,
-                                  std::abs(best.normal.dot(ray.direction)), &rng_);
+    p.true_range_m = main.hit.t;
+    p.true_p_in_lidar = beam_l * main.hit.t;
+    p.cos_incidence = std::abs(main.hit.normal.dot(ray.direction));
+    p.reflectivity =
+        Reflectivity(options_.reflectivity, *main.material, main.hit.t, p.cos_incidence, &rng_);
     p.line = line;
-    p.object = best_object;
-    p.primitive = best.primitive;
-    scan->points.push_back(p);
+    p.object = main.object;
+    p.primitive = main.hit.primitive;
+
+    // Depth edges: a second sample of the footprint.
+    double signal_range = main.hit.t;
+    bool two_returns = false;
+    Hit other;
+    Eigen::Vector3d probe_l = beam_l;
+    if (imp.multi_return ||
+        (imp.mixed_pixel_probability > 0.0 &&
+         CounterUniform(imperfection_key_, pulse, kMixDecision) <= imp.mixed_pixel_probability)) {
+      // Uniform over the elliptic footprint.
+      const double radius = std::sqrt(CounterUniform(imperfection_key_, pulse, kProbeRadius));
+      const double angle = 2.0 * M_PI * CounterUniform(imperfection_key_, pulse, kProbeAngle);
+      probe_l = (beam_l + radius * (std::cos(angle) * half_divergence_h * axis_h +
+                                    std::sin(angle) * half_divergence_v * axis_v))
+                    .normalized();
+      other = Cast(Ray{ray.origin, T_W_l.R_W_b * probe_l}, t);
+      const bool other_surface =
+          other.object != main.object || other.hit.primitive != main.hit.primitive;
+      if (other.hit.hit() && other.hit.t >= sensor.blind_range_m && other_surface &&
+          std::abs(other.hit.t - main.hit.t) > imp.edge_min_separation_m) {
+        if (imp.multi_return) {
+          two_returns = true;
+        } else {
+          const double weight = 1.0 - CounterUniform(imperfection_key_, pulse, kMixWeight);
+          signal_range = main.hit.t + weight * (other.hit.t - main.hit.t);
+          p.mixed = true;
+          p.mixed_other_range_m = other.hit.t;
+        }
+      }
+    }
+    p.p_in_lidar = dir_l * MeasuredRange(sensor, imp, divergence_rms, signal_range, p.cos_incidence,
+                                         p.reflectivity, range_draw);
+    if (!two_returns) {
+      scan->points.push_back(p);
+      continue;
+    }
+    // Dual return: both surfaces, reported along the same nominal direction,
+    // the nearer one first.
+    SimulatedPoint q = p;
+    q.true_range_m = other.hit.t;
+    q.true_p_in_lidar = probe_l * other.hit.t;
+    q.cos_incidence = std::abs(other.hit.normal.dot(T_W_l.R_W_b * probe_l));
+    q.reflectivity = Reflectivity(options_.reflectivity, *other.material, other.hit.t,
+                                  q.cos_incidence, &second_return_rng_);
+    q.object = other.object;
+    q.primitive = other.hit.primitive;
+    double second_noise, unused;
+    NormalPair(imperfection_key_, pulse, kSecondReturnNoise, &second_noise, &unused);
+    q.p_in_lidar = dir_l * MeasuredRange(sensor, imp, divergence_rms, other.hit.t, q.cos_incidence,
+                                         q.reflectivity, second_noise);
+    const bool main_first = main.hit.t <= other.hit.t;
+    p.tag = main_first ? kFirstReturn : kSecondReturn;
+    q.tag = main_first ? kSecondReturn : kFirstReturn;
+    scan->points.push_back(main_first ? p : q);
+    scan->points.push_back(main_first ? q : p);
   }
+}
+
+LidarModel::Hit LidarModel::Cast(const Ray& ray, double t) const {
+  const double max_range = options_.sensor.max_range_m;
+  Hit h;
+  if (scene_->Intersect(ray, 0.0, max_range, &h.hit)) {
+    h.material = &scene_->primitives()[h.hit.primitive].material();
+  }
+  for (const Candidate& c : candidates_) {
+    if (!RayNearSphere(ray, c.center, c.radius, h.hit.hit() ? h.hit.t : max_range)) continue;
+    const MovingObject& obj = (*objects_)[c.object];
+    const Pose T_W_o = obj.trajectory->PoseAt(t);
+    // The ray in the object's body frame.
+    const Ray ray_o{T_W_o.R_W_b.transpose() * (ray.origin - T_W_o.p_b_in_W),
+                    T_W_o.R_W_b.transpose() * ray.direction};
+    RayHit hit_o;
+    if (IntersectBruteForce(obj.parts_b, ray_o, 0.0, h.hit.hit() ? h.hit.t : max_range, &hit_o)) {
+      h.hit = hit_o;
+      h.hit.normal = T_W_o.R_W_b * hit_o.normal;
+      h.object = c.object;
+      h.material = &obj.parts_b[hit_o.primitive].material();
+    }
+  }
+  return h;
 }
 
 }  // namespace swarmlio::sim

@@ -2,10 +2,137 @@
 
 #include <cinttypes>
 #include <cstdio>
+#include <iomanip>
+#include <sstream>
 
 #include "swarmlio/common/check.h"
+#include "swarmlio/config/dump_options.h"
+#include "swarmlio/math/so3.h"
 
 namespace swarmlio::sim {
+namespace {
+
+std::string Vec(const Eigen::Vector3d& v) {
+  std::ostringstream os;
+  os << std::setprecision(17) << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  return os.str();
+}
+
+// Row-major, as the YAML of Eigen::Matrix3d options.
+std::string Mat(const Eigen::Matrix3d& m) {
+  std::ostringstream os;
+  os << std::setprecision(17) << "[";
+  for (int i = 0; i < 9; ++i) os << (i ? ", " : "") << m(i / 3, i % 3);
+  os << "]";
+  return os.str();
+}
+
+std::string Quat(const Eigen::Quaterniond& q) {
+  std::ostringstream os;
+  os << std::setprecision(17) << "[" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w()
+     << "]";
+  return os.str();
+}
+
+std::string Indented(const std::string& block, const std::string& indent) {
+  std::ostringstream os;
+  std::istringstream lines(block);
+  for (std::string line; std::getline(lines, line);) os << indent << line << "\n";
+  return os.str();
+}
+
+}  // namespace
+
+std::string ResolvedScenarioYaml(const Scenario& s, const Simulator& sim) {
+  std::ostringstream os;
+  os << std::setprecision(17);
+  os << "# Resolved scenario '" << s.options.name << "' (written by swarmlio_sim)\n";
+  os << config::DumpOptions(s.options, "scenario");
+  os << "imperfections: " << config::EnumToString(s.imperfections) << "\n";
+  os << "num_static_primitives: " << sim.scene().primitives().size() << "\n";
+  os << "drones:\n";
+  for (size_t i = 0; i < sim.drones().size(); ++i) {
+    const DroneConfig& d = sim.drones()[i];
+    const Pose T = sim.T_W_G(static_cast<int>(i));
+    os << "  - name: " << d.name << "\n";
+    os << "    # Global frame G_i = IMU frame at t = 0, in the simulation world W\n";
+    os << "    p_Gi_in_W_m: " << Vec(T.p_b_in_W) << "\n";
+    os << "    q_W_Gi_xyzw: " << Quat(Eigen::Quaterniond(T.R_W_b)) << "\n";
+    os << "    q_imu_lidar_xyzw: " << Quat(d.lidar.sensor.QuaternionImuLidar()) << "\n";
+    os << "    clock_offset_s: " << d.clock_offset_s << "\n";
+    os << "    clock_drift_ppm: " << d.clock_drift_ppm << "\n";
+    const std::string block = config::DumpOptions(d.lidar, "lidar") +
+                              config::DumpOptions(d.imu, "imu") +
+                              config::DumpOptions(d.body, "body");
+    os << Indented(block, "    ");
+    const SensorCalibration truth = TrueCalibration(d);
+    const SensorCalibration given = GivenCalibration(d);
+    const ImuErrors imu = sim.ImuErrorsOf(static_cast<int>(i));
+    os << "    # The truth of this drone's sensors and clock (for evaluation): the\n"
+          "    # simulation used these; swarm.yaml hands the estimator `given_calibration`.\n";
+    os << "    truth:\n";
+    os << "      R_imu_lidar: " << Mat(truth.R_imu_lidar) << "\n";
+    os << "      p_lidar_in_imu_m: " << Vec(truth.p_lidar_in_imu_m) << "\n";
+    os << "      imu_time_offset_s: " << truth.imu_time_offset_s << "\n";
+    os << "      # drone clock = stamp_origin_s + t * (1 + clock_drift_ppm * 1e-6) + "
+          "clock_offset_s\n";
+    os << "      clock_offset_s: " << d.clock_offset_s << "\n";
+    os << "      clock_drift_ppm: " << d.clock_drift_ppm << "\n";
+    os << "      # gyro = M_g (w + vibration) + ..., accel = M_a (f + vibration) + ...\n";
+    os << "      imu_gyro_matrix: " << Mat(imu.gyro_matrix) << "\n";
+    os << "      imu_accel_matrix: " << Mat(imu.accel_matrix) << "\n";
+    os << "      imu_gyro_vibration_phase_rad: " << Vec(imu.gyro_phase_rad) << "\n";
+    os << "      imu_gyro_vibration_harmonic_phase_rad: " << Vec(imu.gyro_harmonic_phase_rad)
+       << "\n";
+    os << "      imu_accel_vibration_phase_rad: " << Vec(imu.accel_phase_rad) << "\n";
+    os << "      imu_accel_vibration_harmonic_phase_rad: " << Vec(imu.accel_harmonic_phase_rad)
+       << "\n";
+    os << "    given_calibration:\n";
+    os << "      R_imu_lidar: " << Mat(given.R_imu_lidar) << "\n";
+    os << "      p_lidar_in_imu_m: " << Vec(given.p_lidar_in_imu_m) << "\n";
+    os << "      imu_time_offset_s: " << given.imu_time_offset_s << "\n";
+    os << "      # given = truth (+) error: R_given = R_true Exp(rotation_error_rad)\n";
+    os << "      rotation_error_rad: " << Vec(d.calibration_error.rotation_rad) << "\n";
+    os << "      rotation_error_deg: " << d.calibration_error.rotation_rad.norm() * 180.0 / M_PI
+       << "\n";
+    os << "      translation_error_m: " << Vec(d.calibration_error.translation_m) << "\n";
+    os << "      imu_time_offset_error_s: " << d.calibration_error.imu_time_offset_s << "\n";
+  }
+  return os.str();
+}
+
+std::string ReplayManifestYaml(const Scenario& s, const Simulator& sim) {
+  std::ostringstream os;
+  os << std::setprecision(17);
+  os << "# Replay manifest of the simulated run (written by swarmlio_sim).\n";
+  os << "# swarmlio_replay --manifest=<this file> --output_dir=...\n";
+  os << "# The extrinsic (lidar.R_imu_lidar, lidar.p_lidar_in_imu_m) and\n";
+  os << "# odometry.imu_time_offset_s are the calibration handed to the estimator\n";
+  os << "# (imperfections: " << config::EnumToString(s.imperfections)
+     << "); the truth is in resolved_scenario.yaml (drones[i].truth).\n";
+  os << "name: " << s.options.name << "\n";
+  os << "drones:\n";
+  for (size_t i = 0; i < sim.drones().size(); ++i) {
+    const DroneConfig& d = sim.drones()[i];
+    const Pose T = sim.T_W_G(static_cast<int>(i));
+    const SensorCalibration given = GivenCalibration(d);
+    LidarOptions lidar = d.lidar.sensor;
+    lidar.R_imu_lidar = given.R_imu_lidar;
+    lidar.p_lidar_in_imu_m = given.p_lidar_in_imu_m;
+    os << "  - name: " << d.name << "\n";
+    os << "    bag: " << d.name << ".bag\n";
+    os << "    # G_i in the simulation world W (for plots)\n";
+    os << "    p_G_in_W_m: " << Vec(T.p_b_in_W) << "\n";
+    os << "    q_W_G_xyzw: " << Quat(Eigen::Quaterniond(T.R_W_b)) << "\n";
+    os << "    ground_truth: " << d.name << "_gt_tum.txt\n";
+    os << Indented(config::DumpOptions(lidar, "lidar"), "    ");
+    os << Indented(config::DumpOptions(d.imu.sensor, "imu"), "    ");
+    os << "    odometry:\n";
+    os << "      # IMU stamps later than the LiDAR's (as calibrated)\n";
+    os << "      imu_time_offset_s: " << given.imu_time_offset_s << "\n";
+  }
+  return os.str();
+}
 
 io::BagWriterOptions BagOptionsFor(const io::BagWriterOptions& base, const LidarOptions& lidar) {
   io::BagWriterOptions options = base;

@@ -228,6 +228,7 @@ struct DroneSpec {
   MotionSpec motion;
   std::string sensor_preset;  // "" = the sensor structs' defaults
   double clock_offset_s = 0.0;
+  double clock_drift_ppm = 0.0;
   SimulatedLidarOptions lidar;
   SimulatedImuOptions imu;
   DroneBodyOptions body;
@@ -236,14 +237,17 @@ struct DroneSpec {
     motion.VisitFields(v);
     v("sensor_preset", sensor_preset,
       FieldSpec::Doc("sensor preset (configs/*.yaml) under the lidar: and imu: keys"));
-    v("clock_offset_s", clock_offset_s, FieldSpec::InRange(-100, 100, "s", "clock - true time"));
+    v("clock_offset_s", clock_offset_s,
+      FieldSpec::InRange(-100, 100, "s", "clock - true time at t = 0"));
+    v("clock_drift_ppm", clock_drift_ppm,
+      FieldSpec::InRange(-1000, 1000, "ppm", "clock rate error (plus imperfections.clock)"));
     v("lidar", lidar);
     v("imu", imu);
     v("body", body);
   }
   std::string Validate() const {
-    if (sensor_preset.empty()) return config::ValidateFields(*this);
-    // The sensors are validated once merged over the preset (ApplySensorPreset).
+    // The sensors are validated once merged over the preset and the
+    // scenario's imperfections (ResolveDroneSensors).
     DroneSpec without_sensors = *this;
     without_sensors.lidar = SimulatedLidarOptions();
     without_sensors.imu = SimulatedImuOptions();
@@ -298,6 +302,18 @@ struct GeneratorSpec {
   std::string Validate() const { return config::ValidateFields(*this); }
 };
 
+// The `imperfections:` map as read in the first pass: its keys and types are
+// checked, its values only once applied over the preset for each drone's
+// LiDAR type (ScenarioImperfections), since they may rely on the preset.
+struct DeferredImperfections {
+  ImperfectionOptions options;
+  template <class V>
+  void VisitFields(V&& v) {
+    options.VisitFields(v);
+  }
+  std::string Validate() const { return {}; }
+};
+
 // The whole scenario file.
 struct ScenarioFile {
   ScenarioOptions scenario;
@@ -306,6 +322,10 @@ struct ScenarioFile {
   std::vector<DroneSpec> drones;
   std::vector<ObjectSpec> objects;
   GeneratorSpec generator;
+  // `imperfections: realistic` names a preset; a map is a preset plus keys.
+  bool imperfections_by_name = false;
+  ImperfectionPreset imperfections_preset = ImperfectionPreset::kIdeal;
+  DeferredImperfections imperfections;
   template <class V>
   void VisitFields(V&& v) {
     v("scenario", scenario);
@@ -314,9 +334,47 @@ struct ScenarioFile {
     v("drones", drones, FieldSpec::Doc("the drones, each with sensors and a flight plan"));
     v("objects", objects, FieldSpec::Doc("moving decoys"));
     v("generator", generator);
+    if (imperfections_by_name) {
+      v("imperfections", imperfections_preset, FieldSpec::Doc("sensor imperfections preset"));
+    } else {
+      v("imperfections", imperfections, FieldSpec::Doc("sensor imperfections"));
+    }
   }
   std::string Validate() const { return config::ValidateFields(*this); }
+  ImperfectionPreset preset() const {
+    return imperfections_by_name ? imperfections_preset : imperfections.options.preset;
+  }
 };
+
+// Scenario-level imperfections for a drone whose LiDAR is of `type`: the
+// values of `preset` with the file's `imperfections:` keys over them.
+Status ScenarioImperfections(const config::ConfigFile& file,
+                             const ScenarioFile& spec,
+                             ImperfectionPreset preset,
+                             LidarType type,
+                             ImperfectionOptions* imperfections) {
+  ImperfectionOptions o = ImperfectionOptions::ForPreset(preset, type);
+  if (!spec.imperfections_by_name) SWARMLIO_RETURN_IF_ERROR(file.Read("imperfections", &o));
+  o.preset = preset;
+  *imperfections = o;
+  return Status::Ok();
+}
+
+// The per-drone draws of the scenario-level imperfections: clock drift and
+// calibration error of drone `index`.
+void DrawDroneImperfections(const ImperfectionOptions& imperfections,
+                            uint64_t seed,
+                            size_t index,
+                            DroneConfig* drone) {
+  if (imperfections.clock.drift_sigma_ppm > 0.0) {
+    drone->clock_drift_ppm +=
+        DrawClockDriftPpm(imperfections.clock, DeriveSeed(seed, index, streams::kClockDrift));
+  }
+  if (imperfections.calibration.Any()) {
+    drone->calibration_error = DrawCalibrationError(
+        imperfections.calibration, DeriveSeed(seed, index, streams::kCalibrationError));
+  }
+}
 
 // The sensors of preset `path` (a key of `file` names it in errors) with
 // nothing else set: the simulation-only settings keep their defaults.
@@ -331,16 +389,28 @@ Status LoadPresetSensors(const config::ConfigFile& file,
   return status.ok() ? status : file.KeyError(key, status.message());
 }
 
-// Replaces the drone's sensors by its preset with the drone's own `lidar:` and
-// `imu:` keys read over it (and validated).
-Status ApplySensorPreset(const config::ConfigFile& file,
-                         const std::string& key,
-                         const std::filesystem::path& preset_dir,
-                         DroneSpec* drone) {
+// Sets the drone's sensors: its preset (or the defaults) with the scenario's
+// imperfections for its LiDAR type, then the drone's own `lidar:` and `imu:`
+// keys read over them (and validated). *imperfections: the scenario level.
+Status ResolveDroneSensors(const config::ConfigFile& file,
+                           const ScenarioFile& spec,
+                           ImperfectionPreset preset,
+                           const std::string& key,
+                           const std::filesystem::path& preset_dir,
+                           DroneSpec* drone,
+                           ImperfectionOptions* imperfections) {
   SimulatedLidarOptions lidar;
   SimulatedImuOptions imu;
-  SWARMLIO_RETURN_IF_ERROR(LoadPresetSensors(
-      file, key + ".sensor_preset", (preset_dir / drone->sensor_preset).string(), &lidar, &imu));
+  if (!drone->sensor_preset.empty()) {
+    SWARMLIO_RETURN_IF_ERROR(LoadPresetSensors(
+        file, key + ".sensor_preset", (preset_dir / drone->sensor_preset).string(), &lidar, &imu));
+  }
+  // The drone's own type when it sets one (the first pass read it), else the preset's.
+  const LidarType type =
+      file.HasKey(key + ".lidar.type") ? drone->lidar.sensor.type : lidar.sensor.type;
+  SWARMLIO_RETURN_IF_ERROR(ScenarioImperfections(file, spec, preset, type, imperfections));
+  lidar.imperfections = imperfections->lidar;
+  imu.imperfections = imperfections->imu;
   SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".lidar", &lidar));
   SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".imu", &imu));
   drone->lidar = lidar;
@@ -355,11 +425,13 @@ void AddArena(const ArenaSpec& a, Scene* scene) {
 }
 
 Status Generate(const config::ConfigFile& file,
-                const GeneratorSpec& g,
+                const ScenarioFile& spec,
+                ImperfectionPreset preset,
                 const std::filesystem::path& preset_dir,
                 uint64_t seed,
                 double duration_s,
                 Scenario* s) {
+  const GeneratorSpec& g = spec.generator;
   std::vector<SimulatedLidarOptions> lidars(g.sensor_presets.size());
   std::vector<SimulatedImuOptions> imus(g.sensor_presets.size());
   for (size_t j = 0; j < g.sensor_presets.size(); ++j) {
@@ -388,7 +460,8 @@ Status Generate(const config::ConfigFile& file,
     d.name = "uav" + std::to_string(i + 1);
     const Eigen::Vector3d start((i % cols - 0.5 * (cols - 1)) * g.spacing_m,
                                 (i / cols - 0.5 * (cols - 1)) * g.spacing_m, 0.1);
-    TrajectoryBuilder b(start, 0.0, TrajectoryBuilderOptions(), DeriveSeed(seed, i, 3));
+    TrajectoryBuilder b(start, 0.0, TrajectoryBuilderOptions(),
+                        DeriveSeed(seed, i, streams::kTrajectory));
     b.Hover(3.0);
     b.Takeoff(g.flight_height_m + 0.3 * (i % 3));
     b.Excite(std::max(4.0, duration_s - b.duration() - 2.0), Eigen::Vector3d(1.0, 1.0, 0.3), 0.5,
@@ -398,6 +471,12 @@ Status Generate(const config::ConfigFile& file,
       d.lidar = lidars[static_cast<size_t>(i) % lidars.size()];
       d.imu = imus[static_cast<size_t>(i) % imus.size()];
     }
+    ImperfectionOptions imperfections;
+    SWARMLIO_RETURN_IF_ERROR(
+        ScenarioImperfections(file, spec, preset, d.lidar.sensor.type, &imperfections));
+    d.lidar.imperfections = imperfections.lidar;
+    d.imu.imperfections = imperfections.imu;
+    DrawDroneImperfections(imperfections, seed, s->drones.size(), &d);
     s->drones.push_back(std::move(d));
   }
   return Status::Ok();
@@ -417,9 +496,13 @@ SimulationConfig Scenario::simulation_config() const {
 
 namespace {
 
-Status BuildScenario(const config::ConfigFile& file, Scenario* scenario) {
+Status BuildScenario(const config::ConfigFile& file,
+                     const ScenarioOverrides& overrides,
+                     Scenario* scenario) {
   ScenarioFile spec;
+  spec.imperfections_by_name = file.HasKey("imperfections") && !file.HasSection("imperfections");
   SWARMLIO_RETURN_IF_ERROR(file.Read("", &spec));
+  const ImperfectionPreset preset = overrides.imperfections.value_or(spec.preset());
   // Each drone's bag is written in its own LiDAR's format (lidar.message_format).
   for (const char* key : {"bag.lidar_format", "bag.point_time_unit"}) {
     if (file.HasKey(key)) {
@@ -435,34 +518,37 @@ Status BuildScenario(const config::ConfigFile& file, Scenario* scenario) {
   Scenario s;
   s.options = spec.scenario;
   s.bag = spec.bag;
+  s.imperfections = preset;
   AddArena(spec.scene.arena, &s.scene);
   for (const PrimitiveSpec& p : spec.scene.primitives) s.scene.Add(p.Make());
 
   for (size_t i = 0; i < spec.drones.size(); ++i) {
     DroneSpec& d = spec.drones[i];
     const std::string key = config::IndexKey("drones", i);
-    if (!d.sensor_preset.empty()) {
-      SWARMLIO_RETURN_IF_ERROR(ApplySensorPreset(file, key, preset_dir, &d));
-    }
+    ImperfectionOptions imperfections;
+    SWARMLIO_RETURN_IF_ERROR(
+        ResolveDroneSensors(file, spec, preset, key, preset_dir, &d, &imperfections));
     DroneConfig c;
     c.name = d.motion.name.empty() ? "uav" + std::to_string(i + 1) : d.motion.name;
-    c.trajectory = d.motion.Build(DeriveSeed(seed, i, 3), duration_s);
+    c.trajectory = d.motion.Build(DeriveSeed(seed, i, streams::kTrajectory), duration_s);
     c.lidar = d.lidar;
     c.imu = d.imu;
     c.body = d.body;
     c.clock_offset_s = d.clock_offset_s;
+    c.clock_drift_ppm = d.clock_drift_ppm;
+    DrawDroneImperfections(imperfections, seed, i, &c);
     s.drones.push_back(std::move(c));
   }
   for (size_t i = 0; i < spec.objects.size(); ++i) {
     const ObjectSpec& o = spec.objects[i];
     MovingObjectConfig c;
     c.name = o.motion.name.empty() ? "object" + std::to_string(i + 1) : o.motion.name;
-    c.trajectory = o.motion.Build(DeriveSeed(seed, 1000 + i, 3), duration_s);
+    c.trajectory = o.motion.Build(DeriveSeed(seed, 1000 + i, streams::kTrajectory), duration_s);
     for (const PrimitiveSpec& p : o.parts) c.parts_b.push_back(p.Make());
     s.objects.push_back(std::move(c));
   }
   if (spec.generator.num_drones > 0) {
-    SWARMLIO_RETURN_IF_ERROR(Generate(file, spec.generator, preset_dir, seed, duration_s, &s));
+    SWARMLIO_RETURN_IF_ERROR(Generate(file, spec, preset, preset_dir, seed, duration_s, &s));
   }
 
   if (s.drones.empty()) return file.KeyError("drones", "the scenario has no drones");
@@ -481,16 +567,21 @@ Status BuildScenario(const config::ConfigFile& file, Scenario* scenario) {
 
 }  // namespace
 
-Status ParseScenario(const std::string& yaml_text, const std::string& name, Scenario* scenario) {
+Status ParseScenario(const std::string& yaml_text,
+                     const std::string& name,
+                     Scenario* scenario,
+                     const ScenarioOverrides& overrides) {
   config::ConfigFile file;
   SWARMLIO_RETURN_IF_ERROR(config::ConfigFile::Parse(yaml_text, name, &file));
-  return BuildScenario(file, scenario);
+  return BuildScenario(file, overrides, scenario);
 }
 
-Status LoadScenario(const std::string& path, Scenario* scenario) {
+Status LoadScenario(const std::string& path,
+                    Scenario* scenario,
+                    const ScenarioOverrides& overrides) {
   config::ConfigFile file;
   SWARMLIO_RETURN_IF_ERROR(config::ConfigFile::Load(path, &file));
-  return BuildScenario(file, scenario);
+  return BuildScenario(file, overrides, scenario);
 }
 
 }  // namespace swarmlio::sim

@@ -7,22 +7,20 @@
 #include "swarmlio/common/check.h"
 
 namespace swarmlio::sim {
-namespace {
-
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
+SensorCalibration TrueCalibration(const DroneConfig& drone) {
+  SensorCalibration c;
+  c.R_imu_lidar = drone.lidar.sensor.QuaternionImuLidar().toRotationMatrix();
+  c.p_lidar_in_imu_m = drone.lidar.sensor.p_lidar_in_imu_m;
+  c.imu_time_offset_s = drone.imu.time_offset_s;
+  return c;
 }
 
-constexpr uint64_t kImuStream = 1;
-constexpr uint64_t kLidarStream = 2;
-
-}  // namespace
-
-uint64_t DeriveSeed(uint64_t seed, uint64_t drone, uint64_t stream) {
-  return SplitMix64(SplitMix64(SplitMix64(seed) ^ drone) ^ stream);
+SensorCalibration GivenCalibration(const DroneConfig& drone) {
+  SensorCalibration c = ApplyCalibrationError(TrueCalibration(drone), drone.calibration_error);
+  if (drone.calibration_error.rotation_rad.isZero(0.0)) {
+    c.R_imu_lidar = drone.lidar.sensor.R_imu_lidar;  // as configured, not re-projected
+  }
+  return c;
 }
 
 Simulator::Simulator(Scene scene, std::vector<DroneConfig> drones,
@@ -53,7 +51,15 @@ Simulator::Simulator(Scene scene, std::vector<DroneConfig> drones,
 Pose Simulator::T_W_G(int drone) const { return drones_.at(drone).trajectory.PoseAt(0.0); }
 
 int64_t Simulator::StampNs(int drone, double t) const {
-  return std::llround((config_.stamp_origin_s + t + drones_.at(drone).clock_offset_s) * 1e9);
+  const DroneConfig& d = drones_.at(drone);
+  // Without drift this is exactly the drift-free expression (t * 1 == t).
+  const double clock_t = t * (1.0 + d.clock_drift_ppm * 1e-6);
+  return std::llround((config_.stamp_origin_s + clock_t + d.clock_offset_s) * 1e9);
+}
+
+ImuErrors Simulator::ImuErrorsOf(int drone) const {
+  return ImuModel::DrawErrors(drones_.at(drone).imu,
+                              DeriveSeed(config_.seed, drone, streams::kImu));
 }
 
 Status Simulator::Run(const std::vector<DroneSink*>& sinks, std::vector<DroneStats>* stats) const {
@@ -83,9 +89,9 @@ Status Simulator::RunDrone(int drone, DroneSink* sink, DroneStats* stats) const 
   CHECK(sink != nullptr && stats != nullptr);
   *stats = DroneStats();
   const DroneConfig& d = drones_.at(drone);
-  ImuModel imu(d.imu, &d.trajectory, 0.0, DeriveSeed(config_.seed, drone, kImuStream));
+  ImuModel imu(d.imu, &d.trajectory, 0.0, DeriveSeed(config_.seed, drone, streams::kImu));
   LidarModel lidar(d.lidar, &d.trajectory, &scene_, &objects_, drone,
-                   DeriveSeed(config_.seed, drone, kLidarStream));
+                   DeriveSeed(config_.seed, drone, streams::kLidar));
   const Pose T_W_Gi = T_W_G(drone);
   const Eigen::Matrix3d R_G_W = T_W_Gi.R_W_b.transpose();
   const bool livox = d.lidar.sensor.message_format == LidarMessageFormat::kLivoxCustomMsg;
@@ -104,8 +110,9 @@ Status Simulator::RunDrone(int drone, DroneSink* sink, DroneStats* stats) const 
       if (t_imu >= frame_end && t_gt >= frame_end) break;
       if (t_imu <= t_gt) {
         const ImuMeasurement m = imu.Next();
+        if (m.dropped) continue;  // lost on the way (imu.imperfections)
         ImuSample sample;
-        sample.stamp_ns = StampNs(drone, m.t + d.imu.time_offset_s);
+        sample.stamp_ns = StampNs(drone, m.t + d.imu.time_offset_s + m.stamp_jitter_s);
         sample.angular_velocity_rad_s = m.gyro;
         sample.linear_acceleration = m.accel;
         sample.frame_id = "livox_imu";
@@ -137,7 +144,7 @@ Status Simulator::RunDrone(int drone, DroneSink* sink, DroneStats* stats) const 
       out.reflectivity = static_cast<float>(p.reflectivity);
       // The sensor reports integer nanoseconds: quantise like the log will.
       out.offset_time_s = StampSeconds(StampNs(drone, p.t_s) - scan.stamp_ns);
-      out.tag = 0x10;  // Livox: single return, normal point
+      out.tag = p.tag;  // Livox: return number (0x10 first), normal point
       out.line = p.line;
       if (p.object >= 0 && p.object < static_cast<int>(drones_.size())) {
         ++stats->points_on_teammates;

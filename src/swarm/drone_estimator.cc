@@ -165,9 +165,11 @@ struct DroneEstimator::Impl {
   bool broadcast_extrinsics_once = false;
   std::deque<PendingPassive> passive;
   MutualObservationModel model;
+  LidarScan selected;  // the raw points handed to the detector
   std::vector<UndistortedPoint> undistorted;
   std::vector<teammate::ScanPoint> points;
   teammate::ScanResult detection;
+  double last_detection_stamp_s = 0.0;
   Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();
   // The scan in flight (between OnFrontEnd and OnScanDone).
   SwarmPart part;
@@ -334,6 +336,44 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   return Status::Ok();
 }
 
+void DroneEstimator::SelectDetectorPoints(const LidarScan& raw, int64_t t_k, const SwarmState& x,
+                                          const Eigen::Matrix3d& R_imu_lidar,
+                                          LidarScan* selected) const {
+  const teammate::TeammateDetectorOptions& d = options_.teammate;
+  const float min_reflectivity = static_cast<float>(d.clustering.min_reflectivity);
+  // Trackers of the last scan, predicted to t_k, in the body frame. The body
+  // moves during the scan and the prediction is rough: a generous margin.
+  constexpr double kMarginM = 1.0;
+  const double radius = std::max(d.association.teammate_region_radius_m,
+                                 d.association.temporary_region_radius_m) +
+                        options_.swarm.map_exclusion_radius_m + kMarginM;
+  const Eigen::Matrix3d R_b_G = x.ego.R_G_b().transpose();
+  std::vector<Eigen::Vector3f> centers_in_lidar;
+  for (const teammate::TrackerState& s : impl_->detection.trackers) {
+    const double dt = Seconds(t_k) - impl_->last_detection_stamp_s;
+    const Eigen::Vector3d p_in_b = R_b_G * (s.p_in_Gi + s.v_in_Gi * dt - x.ego.p_b_in_G);
+    centers_in_lidar.push_back(
+        (R_imu_lidar.transpose() * (p_in_b - lidar_.p_lidar_in_imu_m)).cast<float>());
+  }
+  const float r2 = static_cast<float>(radius * radius);
+  selected->stamp_ns = raw.stamp_ns;
+  selected->frame_id = raw.frame_id;
+  selected->points.clear();
+  for (const LidarPoint& p : raw.points) {
+    bool keep = p.reflectivity >= min_reflectivity;
+    if (!keep) {
+      const Eigen::Vector3f q(p.x, p.y, p.z);
+      for (const Eigen::Vector3f& c : centers_in_lidar) {
+        if ((q - c).squaredNorm() <= r2) {
+          keep = true;
+          break;
+        }
+      }
+    }
+    if (keep) selected->points.push_back(p);
+  }
+}
+
 Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, Eigen::MatrixXd* P,
                                   lio::UpdateRequest* request) {
   Impl& im = *impl_;
@@ -343,9 +383,12 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
   const int64_t t_k = scan.end_stamp_ns;
   const SwarmOptions& so = options_.swarm;
 
-  // 1. The full scan, motion-compensated to its end, with reflectivity.
-  SWARMLIO_RETURN_IF_ERROR(UndistortScan(*scan.raw, *scan.poses,
-                                         lidar_.QuaternionImuLidar().toRotationMatrix(),
+  // 1. The scan at full resolution, motion-compensated to its end, with
+  // reflectivity: the points the detector can use (tape returns, and every
+  // point near a tracked object, where it re-clusters), not the other ~99 %.
+  const Eigen::Matrix3d R_imu_lidar = lidar_.QuaternionImuLidar().toRotationMatrix();
+  SelectDetectorPoints(*scan.raw, t_k, *x, R_imu_lidar, &im.selected);
+  SWARMLIO_RETURN_IF_ERROR(UndistortScan(im.selected, *scan.poses, R_imu_lidar,
                                          lidar_.p_lidar_in_imu_m, &im.undistorted));
   const double end_offset_s = Seconds(t_k - scan.raw->stamp_ns);
   im.points.resize(im.undistorted.size());
@@ -367,6 +410,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
   T_Gi_bi.linear() = x->ego.R_G_b();
   T_Gi_bi.translation() = x->ego.p_b_in_G;
   SWARMLIO_RETURN_IF_ERROR(detector_->ProcessScan(Seconds(t_k), T_Gi_bi, im.points, &im.detection));
+  im.last_detection_stamp_s = Seconds(t_k);
 
   // 3. State blocks: new teammates in, lost or restarted ones out.
   for (const teammate::TeammateIdentification& id : im.detection.identifications) {

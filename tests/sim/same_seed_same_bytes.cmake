@@ -1,6 +1,6 @@
 # Script mode: runs the simulator tool twice with the same seed (1 and 2
 # worker threads) and requires byte-identical outputs; then reads every bag
-# back with swarmlio_bag_info.
+# back with swarmlio_bag_info. EXTRA_ARGS (optional): more simulator flags.
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
@@ -10,7 +10,7 @@ endfunction()
 file(REMOVE_RECURSE ${WORK_DIR})
 foreach(threads 1 2)
   run(${SIM} --scenario ${SCENARIO} --output_dir ${WORK_DIR}/run${threads} --duration_s 1.5
-      --threads ${threads})
+      --threads ${threads} ${EXTRA_ARGS})
 endforeach()
 # The resolved scenario records the thread count, so only the sensor logs and
 # ground truth are compared.

@@ -4,8 +4,9 @@
 // its own G_j, stamps in the observer's clock, 20 ms latency, every scan; each
 // with the teammate's observation of the observer, 2 cm noise). The component
 // must identify the teammate, add its T_Gi_Gj block, fuse active and passive
-// observations, estimate T_Gi_Gj to a few centimetres and keep the ego
-// estimate accurate. Plus the input checks.
+// observations, estimate T_Gi_Gj to a few centimetres, keep the ego estimate
+// accurate, and drop the block when the teammate reboots (new session).
+// Plus the input checks.
 #include "swarmlio/swarm/drone_estimator.h"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include <deque>
 #include <random>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "swarmlio/replay/manifest.h"
@@ -116,12 +118,21 @@ class ObserverSink : public sim::DroneSink {
     for (DroneOutput& o : out) outputs.push_back(std::move(o));
     std::vector<net::SwarmMessage> sent;
     estimator_->PopMessages(&sent);
-    messages_sent += static_cast<int>(sent.size());
+    for (const net::SwarmMessage& m : sent) {
+      if (std::holds_alternative<net::EgoStateMessage>(m)) ++ego_states_sent;
+      if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&m)) {
+        ++extrinsic_messages_sent;
+        for (const net::GlobalExtrinsicEntry& e : g->entries) EXPECT_EQ(e.teammate_id, teammate_);
+      }
+    }
   }
 
   std::vector<DroneOutput> outputs;
   std::vector<PoseStamped> ground_truth;
-  int messages_sent = 0;
+  int ego_states_sent = 0;          // one per scan
+  int extrinsic_messages_sent = 0;  // the own T_Gi_Gj, about once a second once identified
+  double restart_at_s = 1e9;  // the teammate reboots then (new session_start)
+  double mutual_at_s = 1e9;   // from then on the teammate sends its T_Gj_Gi (it identified us)
 
  private:
   // Broadcasts of the teammate that arrived (20 ms after its scan end) by `now_ns`.
@@ -134,7 +145,7 @@ class ObserverSink : public sim::DroneSink {
       net::EgoStateMessage m;
       m.sender_id = teammate_;
       m.stamp_ns = sim_.StampNs(observer_, t);  // synchronised clocks
-      m.session_start_ns = 1;
+      m.session_start_ns = t < restart_at_s ? 1 : 2;
       m.q_Gj_bj = Eigen::Quaterniond(T_Gj_W_.linear() * s.R_W_b).normalized();
       m.p_bj_in_Gj = T_Gj_W_ * s.p_b_in_W;
       m.v_bj_in_Gj = T_Gj_W_.linear() * s.v_b_in_W;
@@ -157,6 +168,21 @@ class ObserverSink : public sim::DroneSink {
       r.arrival_ns = sim_.StampNs(observer_, t + latency_s);
       r.message = m;
       EXPECT_TRUE(estimator_->AddMessage(r).ok());
+      if (t >= mutual_at_s) {
+        // The teammate's estimate of T_Gj_Gi: the truth, 1 cm / 0.2 deg sigma.
+        const Eigen::Isometry3d T_Gj_Gi = T_Gj_W_ * ToIsometry(sim_.T_W_G(observer_));
+        net::GlobalExtrinsicMessage g;
+        g.sender_id = teammate_;
+        g.stamp_ns = m.stamp_ns;
+        net::GlobalExtrinsicEntry e;
+        e.teammate_id = observer_;
+        e.q_Gi_Gj = Eigen::Quaterniond(T_Gj_Gi.linear()).normalized();
+        e.p_Gj_in_Gi = T_Gj_Gi.translation();
+        e.covariance.diagonal() << 1.2e-5, 1.2e-5, 1.2e-5, 1e-4, 1e-4, 1e-4;
+        g.entries.push_back(e);
+        r.message = g;
+        EXPECT_TRUE(estimator_->AddMessage(r).ok());
+      }
     }
   }
 
@@ -169,7 +195,7 @@ class ObserverSink : public sim::DroneSink {
   std::mt19937 rng_;
 };
 
-TEST(DroneEstimator, IdentifiesATeammateAndFusesActiveAndPassiveObservations) {
+TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) {
   sim::Scenario scenario;
   ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
                                     "/configs/scenarios/indoor_3uav.yaml",
@@ -186,14 +212,15 @@ TEST(DroneEstimator, IdentifiesATeammateAndFusesActiveAndPassiveObservations) {
                                      drones[observer].lidar.sensor, &estimator)
                   .ok());
   ObserverSink sink(simulator, observer, teammate, estimator.get());
+  sink.restart_at_s = 21.0;
   sim::DroneStats stats;
   ASSERT_TRUE(simulator.RunDrone(observer, &sink, &stats).ok());
   ASSERT_TRUE(estimator->Flush().ok());
   sink.Collect();
 
   ASSERT_GE(sink.outputs.size(), 180u);
-  EXPECT_EQ(sink.messages_sent, static_cast<int>(sink.outputs.size()));
-  int identified_at = -1, active = 0, passive = 0;
+  EXPECT_EQ(sink.ego_states_sent, static_cast<int>(sink.outputs.size()));
+  int identified_at = -1, removed_at = -1, active = 0, passive = 0;
   for (size_t k = 0; k < sink.outputs.size(); ++k) {
     const DroneOutput& o = sink.outputs[k];
     ASSERT_TRUE(o.ego.state.p_b_in_G.allFinite());
@@ -201,16 +228,28 @@ TEST(DroneEstimator, IdentifiesATeammateAndFusesActiveAndPassiveObservations) {
       EXPECT_EQ(e.drone_id, teammate);
       if (identified_at < 0) identified_at = static_cast<int>(k);
     }
+    if (!o.removed_teammates.empty() && removed_at < 0) removed_at = static_cast<int>(k);
     active += o.active_observations;
     passive += o.passive_observations;
   }
   ASSERT_GE(identified_at, 0) << "teammate never identified";
-  EXPECT_EQ(estimator->odometry().state().layout().teammate_ids(), std::vector<int>{teammate});
   EXPECT_GT(active, 20);
   EXPECT_GT(passive, 20);
+  // The reboot at 21 s (new session_start) removes the block within a scan
+  // or two of the first new message; the state is ego-only again.
+  ASSERT_GT(removed_at, identified_at) << "restarted teammate not removed";
+  // Broadcast right after the identification, then every second until the reboot.
+  EXPECT_GE(sink.extrinsic_messages_sent, (removed_at - identified_at) / 10);
+  EXPECT_LE(sink.extrinsic_messages_sent, (removed_at - identified_at) / 10 + 2);
+  EXPECT_EQ(estimator->counters().teammate_restarts, 1);
+  EXPECT_TRUE(estimator->odometry().state().layout().teammate_ids().empty());
+  EXPECT_NEAR(StampSeconds(sink.outputs[static_cast<size_t>(removed_at)].ego.stamp_ns) -
+                  StampSeconds(sink.outputs.front().ego.stamp_ns),
+              21.0 - StampSeconds(sink.outputs.front().ego.stamp_ns - simulator.StampNs(observer, 0.0)),
+              0.25);
 
-  // T_Gi_Gj at the end against the truth; the ego against its ground truth.
-  const DroneOutput& last = sink.outputs.back();
+  // T_Gi_Gj just before the reboot against the truth.
+  const DroneOutput& last = sink.outputs[static_cast<size_t>(removed_at) - 1];
   ASSERT_EQ(last.teammates.size(), 1u);
   const Eigen::Isometry3d T_true =
       ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
@@ -219,9 +258,10 @@ TEST(DroneEstimator, IdentifiesATeammateAndFusesActiveAndPassiveObservations) {
                                          last.teammates[0].T_Gi_Gj.R_Gi_Gj())
                            .angle() * 180.0 / M_PI;
   const Eigen::Vector3d sigma = last.teammates[0].extrinsic_covariance.diagonal().tail<3>().cwiseSqrt();
-  std::printf("[ figures  ] identified at scan %d, %d active / %d passive fused, T_Gi_Gj error "
-              "%.4f m %.3f deg (1-sigma %.4f %.4f %.4f m)\n",
-              identified_at, active, passive, p_err, r_err, sigma.x(), sigma.y(), sigma.z());
+  std::printf("[ figures  ] identified at scan %d, removed at scan %d, %d active / %d passive "
+              "fused, T_Gi_Gj error %.4f m %.3f deg (1-sigma %.4f %.4f %.4f m)\n",
+              identified_at, removed_at, active, passive, p_err, r_err, sigma.x(), sigma.y(),
+              sigma.z());
   EXPECT_LT(p_err, 0.05);
   EXPECT_LT(r_err, 1.0);
   // The reported uncertainty is neither absurdly small nor large.
@@ -245,6 +285,55 @@ TEST(DroneEstimator, IdentifiesATeammateAndFusesActiveAndPassiveObservations) {
   }
   ASSERT_GT(n, 100);
   EXPECT_LT(std::sqrt(se / n), 0.02);
+}
+
+// The teammate identified this drone first and sends T_Gj_Gi: the component
+// adds the teammate with the inverse (mutual identification) before its own
+// trajectory match would (~14 s), and tracks and fuses it from then on.
+TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
+  sim::Scenario scenario;
+  ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
+                                    "/configs/scenarios/indoor_3uav.yaml",
+                                &scenario)
+                  .ok());
+  sim::SimulationConfig config = scenario.simulation_config();
+  config.duration_s = 13.0;
+  config.num_threads = 1;
+  const std::vector<sim::DroneConfig> drones = scenario.drones;
+  sim::Simulator simulator(std::move(scenario.scene), drones, scenario.objects, config);
+  const int observer = 0, teammate = 1;
+  std::unique_ptr<DroneEstimator> estimator;
+  ASSERT_TRUE(DroneEstimator::Create(observer, OptionsFor(drones[observer]),
+                                     drones[observer].lidar.sensor, &estimator)
+                  .ok());
+  ObserverSink sink(simulator, observer, teammate, estimator.get());
+  sink.mutual_at_s = 10.0;
+  sim::DroneStats stats;
+  ASSERT_TRUE(simulator.RunDrone(observer, &sink, &stats).ok());
+  ASSERT_TRUE(estimator->Flush().ok());
+  sink.Collect();
+
+  std::string method;
+  double identified_s = -1.0;
+  int active = 0;
+  for (const DroneOutput& o : sink.outputs) {
+    for (const IdentificationEvent& e : o.identifications) {
+      if (identified_s < 0.0) {
+        identified_s = StampSeconds(e.stamp_ns) - StampSeconds(simulator.StampNs(observer, 0.0));
+        method = e.method;
+      }
+    }
+    active += o.active_observations;
+  }
+  ASSERT_GE(identified_s, 0.0) << "never identified";
+  EXPECT_EQ(method, "teammate_match");
+  EXPECT_NEAR(identified_s, 10.0, 0.3);
+  EXPECT_GT(active, 5);  // the tracker started at the broadcast position finds the clusters
+  const DroneOutput& last = sink.outputs.back();
+  ASSERT_EQ(last.teammates.size(), 1u);
+  const Eigen::Isometry3d T_true =
+      ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
+  EXPECT_LT((last.teammates[0].T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm(), 0.03);
 }
 
 }  // namespace

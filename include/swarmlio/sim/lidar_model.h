@@ -1,6 +1,9 @@
 // LiDAR measurement model: casts each pulse from the sensor pose at the
 // pulse's own time against the static scene and against every other moving
-// object (teammates, decoys) at that same time.
+// object (teammates, decoys) at that same time. Imperfections (beam angular
+// noise, range noise growing with range and incidence, range walk on dark
+// surfaces, mixed pixels and multiple returns at depth edges, range-dependent
+// dropouts) are in LidarImperfectionOptions (lidar_options.h), off by default.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,10 +22,16 @@ namespace swarmlio::sim {
 /// One return, with ground truth.
 struct SimulatedPoint {
   double t_s = 0.0;                                       // true time of the pulse [s]
-  Eigen::Vector3d p_in_lidar = Eigen::Vector3d::Zero();   // measured (with range noise) [m]
-  double true_range_m = 0.0;
+  Eigen::Vector3d p_in_lidar = Eigen::Vector3d::Zero();   // measured (with all noise) [m]
+  double true_range_m = 0.0;  // range of the surface hit along the beam [m]
+  /// Where the beam (with its angular error) hit that surface, LiDAR frame [m].
+  Eigen::Vector3d true_p_in_lidar = Eigen::Vector3d::Zero();
+  double cos_incidence = 1.0;                             // |cos| beam vs surface normal
   double reflectivity = 0.0;                              // Livox 0-255 scale
   uint8_t line = 0;
+  uint8_t tag = 0x10;                // Livox tag: bits 5:4 return number (01 first, 10 second)
+  bool mixed = false;                // a mixed pixel (range between two surfaces of the footprint)
+  double mixed_other_range_m = 0.0;  // mixed pixels: range of the other surface [m]
   int object = -1;      // -1: static scene; else the index of the moving object hit
   int primitive = -1;   // index into the scene's or the object's primitives
 };
@@ -63,6 +72,13 @@ class LidarModel {
     Eigen::Vector3d center;
     double radius;
   };
+  // The closest surface along a ray at time t (static scene and other objects).
+  struct Hit {
+    RayHit hit;  // normal in W
+    int object = -1;
+    const Material* material = nullptr;
+  };
+  Hit Cast(const Ray& ray, double t) const;
 
   SimulatedLidarOptions options_;
   LidarPattern pattern_;
@@ -73,7 +89,9 @@ class LidarModel {
   double t0_;
   double period_;
   Eigen::Matrix3d R_imu_lidar_;
-  std::mt19937_64 rng_;
+  std::mt19937_64 rng_;                // range noise, random dropouts, reflectivity
+  uint64_t imperfection_key_;          // LidarImperfectionOptions: CounterUniform(key, pulse, draw)
+  std::mt19937_64 second_return_rng_;  // reflectivity of second returns
   std::vector<Candidate> candidates_;
 };
 

@@ -1,5 +1,7 @@
 // Writes one drone's simulated records: a ROS1 bag (IMU, LiDAR, ground truth)
-// and a TUM trajectory file (timestamp tx ty tz qx qy qz qw) of T_Gi_b.
+// and a TUM trajectory file (timestamp tx ty tz qx qy qz qw) of T_Gi_b; and
+// the run's resolved scenario (with the truth of every drawn imperfection)
+// and replay manifest (with the calibration handed to the estimator).
 #pragma once
 
 #include <fstream>
@@ -8,6 +10,7 @@
 
 #include "swarmlio/io/bag_writer.h"
 #include "swarmlio/sensors/lidar_options.h"
+#include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
 
 namespace swarmlio::sim {
@@ -16,6 +19,19 @@ namespace swarmlio::sim {
 /// (its message_format and timestamp_unit): a drone's bag is written the way
 /// its sensor description says the driver publishes.
 io::BagWriterOptions BagOptionsFor(const io::BagWriterOptions& base, const LidarOptions& lidar);
+
+/// resolved_scenario.yaml: the run settings, each drone's T_W_Gi, sensors
+/// and imperfection settings as simulated, and a `truth:` block per drone
+/// (true extrinsic, IMU time offset, clock offset and drift, IMU scale /
+/// misalignment matrices and vibration phases) next to the calibration the
+/// estimator was given. For people and evaluation scripts; nothing reads it.
+std::string ResolvedScenarioYaml(const Scenario& scenario, const Simulator& simulator);
+
+/// swarm.yaml, the replay manifest (docs/replay.md): bags, ground truth, and
+/// each drone's sensors with the calibration handed to the estimator
+/// (GivenCalibration: the truth unless the scenario simulates a calibration
+/// error).
+std::string ReplayManifestYaml(const Scenario& scenario, const Simulator& simulator);
 
 class DroneOutputWriter : public DroneSink {
  public:

@@ -9,11 +9,13 @@
 //    out of range (must be >= 0 m)".
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "swarmlio/common/status.h"
 #include "swarmlio/io/bag_options.h"
+#include "swarmlio/sim/imperfections.h"
 #include "swarmlio/sim/scene.h"
 #include "swarmlio/sim/simulator.h"
 
@@ -50,6 +52,10 @@ struct ScenarioOptions {
 struct Scenario {
   ScenarioOptions options;
   io::BagWriterOptions bag;
+  /// The imperfections preset the drones' sensors start from (each drone's
+  /// resolved values are in its lidar.imperfections, imu.imperfections,
+  /// clock_drift_ppm and calibration_error).
+  ImperfectionPreset imperfections = ImperfectionPreset::kIdeal;
   Scene scene;
   std::vector<DroneConfig> drones;
   std::vector<MovingObjectConfig> objects;
@@ -57,10 +63,22 @@ struct Scenario {
   SimulationConfig simulation_config() const;
 };
 
+/// Settings from outside the scenario file (swarmlio_sim flags).
+struct ScenarioOverrides {
+  /// Replaces the file's imperfections preset; the file's single-value
+  /// `imperfections:` keys and the drones' own keys still apply over it.
+  std::optional<ImperfectionPreset> imperfections;
+};
+
 /// Loads and validates a scenario file.
-Status LoadScenario(const std::string& path, Scenario* scenario);
+Status LoadScenario(const std::string& path,
+                    Scenario* scenario,
+                    const ScenarioOverrides& overrides = ScenarioOverrides());
 /// Same for YAML text; `name` stands for the file in messages and in
 /// resolving `scenario.preset_dir` (relative to the folder of `name`).
-Status ParseScenario(const std::string& yaml_text, const std::string& name, Scenario* scenario);
+Status ParseScenario(const std::string& yaml_text,
+                     const std::string& name,
+                     Scenario* scenario,
+                     const ScenarioOverrides& overrides = ScenarioOverrides());
 
 }  // namespace swarmlio::sim

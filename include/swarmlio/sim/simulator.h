@@ -5,8 +5,9 @@
 // not depend on thread scheduling.
 //
 // Time: the true time t starts at 0. Drone i's clock stamps an event at true
-// time t as stamp_origin_s + t + clock_offset_s (IMU samples additionally
-// + imu.time_offset_s). Global frame G_i = drone i's IMU frame at t = 0.
+// time t as stamp_origin_s + t * (1 + clock_drift_ppm * 1e-6) + clock_offset_s
+// (IMU samples additionally + imu.time_offset_s and their stamp jitter).
+// Global frame G_i = drone i's IMU frame at t = 0.
 #pragma once
 
 #include <cstdint>
@@ -16,8 +17,10 @@
 #include "swarmlio/common/status.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/sim/drone_body.h"
+#include "swarmlio/sim/imperfections.h"
 #include "swarmlio/sim/imu_model.h"
 #include "swarmlio/sim/lidar_model.h"
+#include "swarmlio/sim/random.h"
 #include "swarmlio/sim/scene.h"
 #include "swarmlio/sim/trajectory.h"
 
@@ -29,8 +32,17 @@ struct DroneConfig {
   SimulatedLidarOptions lidar;
   SimulatedImuOptions imu;
   DroneBodyOptions body;
-  double clock_offset_s = 0.0;  // drone clock - true time [s]
+  double clock_offset_s = 0.0;   // drone clock - true time at t = 0 [s]
+  double clock_drift_ppm = 0.0;  // drone clock rate - 1 [ppm] (truth)
+  /// Error of the calibration the estimator is given (swarm.yaml); zero =
+  /// the truth. Not used by the simulation itself.
+  CalibrationError calibration_error;
 };
+
+/// The true LiDAR-IMU calibration of a drone (its sensors as simulated).
+SensorCalibration TrueCalibration(const DroneConfig& drone);
+/// The calibration handed to the estimator: the truth with calibration_error.
+SensorCalibration GivenCalibration(const DroneConfig& drone);
 
 struct MovingObjectConfig {
   std::string name;
@@ -84,6 +96,8 @@ class Simulator {
   Pose T_W_G(int drone) const;
   /// Drone-clock stamp of true time t.
   int64_t StampNs(int drone, double t) const;
+  /// Drone i's IMU scale/misalignment and vibration phases (truth).
+  ImuErrors ImuErrorsOf(int drone) const;
 
   /// Simulates every drone; sinks[i] receives drone i. Returns the first error.
   Status Run(const std::vector<DroneSink*>& sinks, std::vector<DroneStats>* stats) const;
@@ -97,8 +111,5 @@ class Simulator {
   std::vector<MovingObject> objects_;
   SimulationConfig config_;
 };
-
-/// Independent 64-bit seed for (base seed, drone, stream) via SplitMix64.
-uint64_t DeriveSeed(uint64_t seed, uint64_t drone, uint64_t stream);
 
 }  // namespace swarmlio::sim

@@ -129,6 +129,11 @@ class DroneEstimator : public lio::ScanStageHooks {
   struct Impl;
   DroneEstimator(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar);
 
+  // The raw points the detector needs: tape returns and points near the
+  // trackers of the last scan (predicted to t_k).
+  void SelectDetectorPoints(const LidarScan& raw, int64_t t_k, const SwarmState& x,
+                            const Eigen::Matrix3d& R_imu_lidar, LidarScan* selected) const;
+
   int self_id_;
   DroneEstimatorOptions options_;
   LidarOptions lidar_;
