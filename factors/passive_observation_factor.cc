@@ -1,16 +1,10 @@
 #include "factors/passive_observation_factor.h"
 
-#include <Eigen/Cholesky>
-
-#include "factors/so3_manifold.h"
-#include "swarmlio/common/check.h"
+#include "factors/observation_factor_util.h"
 #include "swarmlio/math/so3.h"
 
 namespace swarmlio {
 namespace {
-
-using EgoJacobian = Eigen::Matrix<double, 3, EgoState::kAmbientSize, Eigen::RowMajor>;
-using ExtrinsicJacobian = Eigen::Matrix<double, 3, GlobalExtrinsic::kAmbientSize, Eigen::RowMajor>;
 
 Eigen::Matrix3d RotationOf(const Eigen::Quaterniond& q) {
   return q.normalized().toRotationMatrix();
@@ -32,12 +26,7 @@ PassiveObservationFactor::PassiveObservationFactor(const Eigen::Vector3d& p_bi_i
   const Eigen::Matrix3d S = Sigma_obs + h0_hat * Sigma_theta_bj * h0_hat.transpose() +
                             R_Gj_bj_.transpose() * Sigma_p_bj_in_Gj * R_Gj_bj_;
   covariance_ = 0.5 * (S + S.transpose());
-  const Eigen::LLT<Eigen::Matrix3d> llt(covariance_);
-  CHECK(covariance_.allFinite() && llt.info() == Eigen::Success)
-      << "passive observation covariance is not positive definite:\n"
-      << covariance_;
-  sqrt_information_ =
-      llt.matrixL().solve(Eigen::Matrix3d::Identity()).triangularView<Eigen::Lower>();
+  sqrt_information_ = observation_factor::SqrtInformation(covariance_, "passive observation");
 }
 
 Eigen::Vector3d PassiveObservationFactor::EgoPositionInGj(const EgoState& ego,
@@ -84,21 +73,12 @@ bool PassiveObservationFactor::Evaluate(double const* const* parameters,
   r = Residual(ego, extrinsic);
   if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) return true;
 
-  Eigen::Matrix<double, 3, EgoState::kTangentSize> J_ego;
-  Eigen::Matrix<double, 3, GlobalExtrinsic::kTangentSize> J_ext;
-  TangentJacobian(ego, extrinsic, jacobians[0] != nullptr ? &J_ego : nullptr,
-                  jacobians[1] != nullptr ? &J_ext : nullptr);
-  if (jacobians[0] != nullptr) {
-    // The attitude does not enter h: the quaternion columns are zero.
-    Eigen::Map<EgoJacobian> J(jacobians[0]);
-    J.leftCols<4>().setZero();
-    J.rightCols<15>() = J_ego.rightCols<15>();
-  }
-  if (jacobians[1] != nullptr) {
-    Eigen::Map<ExtrinsicJacobian> J(jacobians[1]);
-    J.leftCols<4>() = SO3Manifold::LiftTangentJacobian<3>(J_ext.leftCols<3>(), parameters[1]);
-    J.rightCols<3>() = J_ext.rightCols<3>();
-  }
+  // Both tangent Jacobians are computed (a few flops); only the requested
+  // ambient blocks are written.
+  observation_factor::EgoTangentJacobian J_ego;
+  observation_factor::ExtrinsicTangentJacobian J_ext;
+  TangentJacobian(ego, extrinsic, &J_ego, &J_ext);
+  observation_factor::WriteObservationJacobians(J_ego, J_ext, parameters, jacobians);
   return true;
 }
 

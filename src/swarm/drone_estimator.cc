@@ -2,6 +2,8 @@
 
 #include <ceres/cost_function.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <array>
 #include <memory>
@@ -75,11 +77,16 @@ bool Finite(const net::EgoStateMessage& m) {
 }
 
 // A covariance from the network or the detector, made symmetric positive
-// definite (a floor of (1 mm)^2 on the diagonal).
-Eigen::Matrix3d Regularized(const Eigen::Matrix3d& C, double floor = 1e-6) {
-  Eigen::Matrix3d S = 0.5 * (C + C.transpose());
-  S.diagonal().array() += floor;
-  return S;
+// definite: eigenvalues clamped to at least `floor` ((1 mm)^2 by default).
+// The network checks only finiteness and non-negative variances, so an
+// indefinite matrix from a broken teammate must not reach a factor.
+template <int N>
+Eigen::Matrix<double, N, N> Regularized(const Eigen::Matrix<double, N, N>& C, double floor = 1e-6) {
+  using Matrix = Eigen::Matrix<double, N, N>;
+  const Matrix S = 0.5 * (C + C.transpose());
+  const Eigen::SelfAdjointEigenSolver<Matrix> eig(S);
+  const Eigen::Matrix<double, N, 1> values = eig.eigenvalues().cwiseMax(floor);
+  return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
 }
 
 // Mahalanobis distance^2 of h - z under S.
@@ -446,8 +453,9 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       Eigen::Matrix<double, 6, 6> C;
       InvertExtrinsic(pending.entry, &T, &C);
       if (!detector_->AddIdentifiedTeammate(j, Seconds(t_k), T.R_Gi_Gj(), T.p_Gj_in_Gi)) continue;
-      // At least the covariance of an own match with zero residual.
-      C = 0.5 * (C + C.transpose());
+      // Positive definite whatever arrived, and at least the covariance of an
+      // own match with zero residual.
+      C = Regularized<6>(C, 1e-10);
       for (int k = 0; k < 3; ++k) {
         C(k, k) = std::max(C(k, k), so.init_rotation_sigma_floor_rad * so.init_rotation_sigma_floor_rad);
         C(3 + k, 3 + k) = std::max(C(3 + k, 3 + k), so.init_translation_sigma_floor_m *
@@ -530,7 +538,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       const PredictedTeammate j = Predict(m, so.time_compensation ? age : 0.0);
       const GlobalExtrinsic& T = x->teammate(o.drone_id);
       auto factor = std::make_unique<ActiveObservationFactor>(
-          o.p_bj_in_bi, j.p_bj_in_Gj, Regularized(o.covariance_m2), Regularized(j.cov_p), R_Gi_bi,
+          o.p_bj_in_bi, j.p_bj_in_Gj, Regularized<3>(o.covariance_m2), Regularized<3>(j.cov_p), R_Gi_bi,
           T.R_Gi_Gj());
       const Eigen::Vector3d e = factor->Predict(x->ego, T) - o.p_bj_in_bi;
       const Eigen::Matrix3d S = factor->covariance();
@@ -558,8 +566,8 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       auto factor = std::make_unique<PassiveObservationFactor>(
           p.p_bi_in_bj, so.time_compensation ? dt : 0.0,
           p.sender.q_Gj_bj.normalized().toRotationMatrix(), p.sender.p_bj_in_Gj,
-          Regularized(p.cov), Regularized(p.sender.cov_theta_Gj_bj, 1e-10),
-          Regularized(p.sender.cov_p_bj_in_Gj), x->ego, T);
+          Regularized<3>(p.cov), Regularized<3>(p.sender.cov_theta_Gj_bj, 1e-10),
+          Regularized<3>(p.sender.cov_p_bj_in_Gj), x->ego, T);
       const Eigen::Vector3d e = factor->Predict(x->ego, T) - p.p_bi_in_bj;
       const Eigen::Matrix3d S = factor->covariance();
       if (add(std::move(factor), p.from, e, S)) {

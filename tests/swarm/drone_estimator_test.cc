@@ -33,6 +33,14 @@ Eigen::Isometry3d ToIsometry(const sim::Pose& pose) {
   return T;
 }
 
+sim::Scenario IndoorScenario() {
+  sim::Scenario scenario;
+  const Status status = sim::LoadScenario(
+      std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", &scenario);
+  EXPECT_TRUE(status.ok()) << status.message();
+  return scenario;
+}
+
 DroneEstimatorOptions OptionsFor(const sim::DroneConfig& d) {
   DroneEstimatorOptions o;
   o.odometry = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
@@ -41,11 +49,8 @@ DroneEstimatorOptions OptionsFor(const sim::DroneConfig& d) {
 }
 
 TEST(DroneEstimator, RejectsInvalidOptionsAndIds) {
-  sim::Scenario scenario;
-  ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
-                                    "/configs/scenarios/indoor_3uav.yaml",
-                                &scenario)
-                  .ok());
+  sim::Scenario scenario = IndoorScenario();
+  ASSERT_FALSE(scenario.drones.empty());
   const sim::DroneConfig& d = scenario.drones[0];
   std::unique_ptr<DroneEstimator> e;
   DroneEstimatorOptions o = OptionsFor(d);
@@ -59,11 +64,8 @@ TEST(DroneEstimator, RejectsInvalidOptionsAndIds) {
 }
 
 TEST(DroneEstimator, IgnoresOwnForeignTypedAndNonFiniteMessages) {
-  sim::Scenario scenario;
-  ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
-                                    "/configs/scenarios/indoor_3uav.yaml",
-                                &scenario)
-                  .ok());
+  sim::Scenario scenario = IndoorScenario();
+  ASSERT_FALSE(scenario.drones.empty());
   const sim::DroneConfig& d = scenario.drones[0];
   std::unique_ptr<DroneEstimator> e;
   ASSERT_TRUE(DroneEstimator::Create(0, OptionsFor(d), d.lidar.sensor, &e).ok());
@@ -133,6 +135,7 @@ class ObserverSink : public sim::DroneSink {
   int extrinsic_messages_sent = 0;  // the own T_Gi_Gj, about once a second once identified
   double restart_at_s = 1e9;  // the teammate reboots then (new session_start)
   double mutual_at_s = 1e9;   // from then on the teammate sends its T_Gj_Gi (it identified us)
+  int indefinite_every_k = 0;  // every k-th broadcast has indefinite covariances (0: none)
 
  private:
   // Broadcasts of the teammate that arrived (20 ms after its scan end) by `now_ns`.
@@ -153,6 +156,11 @@ class ObserverSink : public sim::DroneSink {
       m.cov_theta_Gj_bj = 1e-6 * Eigen::Matrix3d::Identity();
       m.cov_p_bj_in_Gj = 1e-5 * Eigen::Matrix3d::Identity();
       m.cov_v_bj_in_Gj = 1e-4 * Eigen::Matrix3d::Identity();
+      if (indefinite_every_k > 0 && next_ % static_cast<size_t>(indefinite_every_k) == 0) {
+        // Passes the wire checks (finite, variances >= 0) but is indefinite.
+        m.cov_p_bj_in_Gj(0, 1) = m.cov_p_bj_in_Gj(1, 0) = 0.5;
+        m.cov_theta_Gj_bj(1, 2) = m.cov_theta_Gj_bj(2, 1) = 0.3;
+      }
       // The teammate sees the observer when it is within 6 m.
       const sim::Pose bi = sim_.drones()[static_cast<size_t>(observer_)].trajectory.PoseAt(t);
       const Eigen::Vector3d p_bi_in_bj = s.R_W_b.transpose() * (bi.p_b_in_W - s.p_b_in_W);
@@ -195,28 +203,46 @@ class ObserverSink : public sim::DroneSink {
   std::mt19937 rng_;
 };
 
-TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) {
-  sim::Scenario scenario;
-  ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
-                                    "/configs/scenarios/indoor_3uav.yaml",
-                                &scenario)
-                  .ok());
-  sim::SimulationConfig config = scenario.simulation_config();
-  config.duration_s = 22.0;  // identification ~14 s, then 8 s of fusion
-  config.num_threads = 1;
-  const std::vector<sim::DroneConfig> drones = scenario.drones;
-  sim::Simulator simulator(std::move(scenario.scene), drones, scenario.objects, config);
-  const int observer = 0, teammate = 1;  // two Mid-360 drones
+// The first `duration_s` of indoor_3uav for one observer fed by ObserverSink.
+struct ObserverRun {
+  ObserverRun(sim::Scenario scenario, double duration_s, int observer, int teammate)
+      : observer(observer) {
+    sim::SimulationConfig config = scenario.simulation_config();
+    config.duration_s = duration_s;
+    config.num_threads = 1;
+    drones = scenario.drones;
+    simulator = std::make_unique<sim::Simulator>(std::move(scenario.scene), drones,
+                                                 scenario.objects, config);
+    const Status created = DroneEstimator::Create(observer, OptionsFor(drones[observer]),
+                                                  drones[observer].lidar.sensor, &estimator);
+    EXPECT_TRUE(created.ok()) << created.message();
+    sink = std::make_unique<ObserverSink>(*simulator, observer, teammate, estimator.get());
+  }
+  bool Run() {
+    sim::DroneStats stats;
+    if (!simulator->RunDrone(observer, sink.get(), &stats).ok()) return false;
+    if (!estimator->Flush().ok()) return false;
+    sink->Collect();
+    return true;
+  }
+  int observer;
+  std::vector<sim::DroneConfig> drones;
+  std::unique_ptr<sim::Simulator> simulator;
   std::unique_ptr<DroneEstimator> estimator;
-  ASSERT_TRUE(DroneEstimator::Create(observer, OptionsFor(drones[observer]),
-                                     drones[observer].lidar.sensor, &estimator)
-                  .ok());
-  ObserverSink sink(simulator, observer, teammate, estimator.get());
+  std::unique_ptr<ObserverSink> sink;
+};
+
+TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) {
+  sim::Scenario scenario = IndoorScenario();
+  ASSERT_FALSE(scenario.drones.empty());
+  const int observer = 0, teammate = 1;  // two Mid-360 drones
+  ObserverRun run(std::move(scenario), 22.0, observer, teammate);  // identification ~14 s
+  ObserverSink& sink = *run.sink;
+  const sim::Simulator& simulator = *run.simulator;
   sink.restart_at_s = 21.0;
-  sim::DroneStats stats;
-  ASSERT_TRUE(simulator.RunDrone(observer, &sink, &stats).ok());
-  ASSERT_TRUE(estimator->Flush().ok());
-  sink.Collect();
+  sink.indefinite_every_k = 7;  // bad covariances must be absorbed, not crash or poison P
+  ASSERT_TRUE(run.Run());
+  DroneEstimator* estimator = run.estimator.get();
 
   ASSERT_GE(sink.outputs.size(), 180u);
   EXPECT_EQ(sink.ego_states_sent, static_cast<int>(sink.outputs.size()));
@@ -291,27 +317,14 @@ TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) 
 // adds the teammate with the inverse (mutual identification) before its own
 // trajectory match would (~14 s), and tracks and fuses it from then on.
 TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
-  sim::Scenario scenario;
-  ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
-                                    "/configs/scenarios/indoor_3uav.yaml",
-                                &scenario)
-                  .ok());
-  sim::SimulationConfig config = scenario.simulation_config();
-  config.duration_s = 13.0;
-  config.num_threads = 1;
-  const std::vector<sim::DroneConfig> drones = scenario.drones;
-  sim::Simulator simulator(std::move(scenario.scene), drones, scenario.objects, config);
+  sim::Scenario scenario = IndoorScenario();
+  ASSERT_FALSE(scenario.drones.empty());
   const int observer = 0, teammate = 1;
-  std::unique_ptr<DroneEstimator> estimator;
-  ASSERT_TRUE(DroneEstimator::Create(observer, OptionsFor(drones[observer]),
-                                     drones[observer].lidar.sensor, &estimator)
-                  .ok());
-  ObserverSink sink(simulator, observer, teammate, estimator.get());
+  ObserverRun run(std::move(scenario), 13.0, observer, teammate);
+  ObserverSink& sink = *run.sink;
+  const sim::Simulator& simulator = *run.simulator;
   sink.mutual_at_s = 10.0;
-  sim::DroneStats stats;
-  ASSERT_TRUE(simulator.RunDrone(observer, &sink, &stats).ok());
-  ASSERT_TRUE(estimator->Flush().ok());
-  sink.Collect();
+  ASSERT_TRUE(run.Run());
 
   std::string method;
   double identified_s = -1.0;
