@@ -129,8 +129,16 @@ Status PlaneMeasurementModel::Linearize(const SwarmState& x, std::vector<Residua
   if (!associate_) return Status::InvalidArgument("no association callback");
   correspondences_.clear();
   SWARMLIO_RETURN_IF_ERROR(associate_(x, &correspondences_));
-  factor_.SyncNumResiduals();  // the update removed last iteration's block
-  if (!correspondences_.empty()) terms->push_back({&factor_, {kEgoBlock}});
+  factor_.SyncNumResiduals();
+  if (correspondences_.empty()) return Status::Ok();
+  // The N point rows enter Ceres as their 6-row information form at x
+  // (PoseInformationFactor): the same Gauss-Newton step, a 6-row instead of
+  // an N-row Jacobian block (docs/esikf.md "Compressed point rows").
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+  factor_.AccumulateNormalEquations(x.ego, &A, &b);
+  compressed_.Set(A, b, x.ego.q_G_b, x.ego.p_b_in_G);
+  terms->push_back({&compressed_, {kEgoBlock}});
   return Status::Ok();
 }
 

@@ -1,5 +1,6 @@
 #include "swarmlio/lio/imu_initializer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -46,11 +47,32 @@ WindowStatistics ComputeStatistics(const std::deque<ImuSample>& window) {
 
 }  // namespace
 
+Eigen::Vector3d UpAxisVector(ImuUpAxis axis) {
+  switch (axis) {
+    case ImuUpAxis::kPlusX:
+      return Eigen::Vector3d::UnitX();
+    case ImuUpAxis::kMinusX:
+      return -Eigen::Vector3d::UnitX();
+    case ImuUpAxis::kPlusY:
+      return Eigen::Vector3d::UnitY();
+    case ImuUpAxis::kMinusY:
+      return -Eigen::Vector3d::UnitY();
+    case ImuUpAxis::kPlusZ:
+      return Eigen::Vector3d::UnitZ();
+    case ImuUpAxis::kMinusZ:
+      return -Eigen::Vector3d::UnitZ();
+    case ImuUpAxis::kNone:
+      break;
+  }
+  return Eigen::Vector3d::Zero();
+}
+
 std::string ImuInitializerOptions::Validate() const {
   std::string error = config::ValidateFields(*this);
   if (!error.empty()) return error;
-  if (acceleration_sign != 1 && acceleration_sign != -1) {
-    return "acceleration_sign: must be +1 or -1 (got " + std::to_string(acceleration_sign) + ")";
+  if (acceleration_sign != 1 && acceleration_sign != -1 && acceleration_sign != 0) {
+    return "acceleration_sign: must be +1, -1 or 0 (auto) (got " +
+           std::to_string(acceleration_sign) + ")";
   }
   return {};
 }
@@ -62,7 +84,22 @@ std::string ImuInitialization::Summary() const {
      << ", factor " << acceleration_to_m_s2 << ", |g| = " << gravity_magnitude_m_s2
      << " m/s^2, g_in_G = [" << state.g_in_G.transpose() << "], gyro bias = ["
      << state.gyro_bias.transpose() << "] rad/s, std gyro " << gyro_stddev_rad_s
-     << " rad/s, std acc " << accel_stddev_m_s2 << " m/s^2";
+     << " rad/s, std acc " << accel_stddev_m_s2 << " m/s^2; accelerometer sign "
+     << (acceleration_sign > 0 ? "+1" : "-1") << (sign_detected ? " (detected)" : " (configured)")
+     << ": acceleration at rest points ";
+  switch (reported_direction) {
+    case SpecificForceDirection::kUp:
+      os << "up (normal)";
+      break;
+    case SpecificForceDirection::kDown:
+      os << "down (sign-flipped driver)";
+      break;
+    case SpecificForceDirection::kUndetermined:
+      os << "neither up nor down (undetermined)";
+      break;
+  }
+  os << ", " << angle_to_up_axis_deg << " deg from up_axis";
+  if (!sign_warning.empty()) os << "; WARNING: " << sign_warning;
   return os.str();
 }
 
@@ -152,7 +189,50 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
       break;
   }
   const double unit_factor = unit == AccelerationUnit::kStandardGravity ? g0 : 1.0;
-  const double factor = options_.acceleration_sign * unit_factor;
+
+  // 1b. Sign: the direction of the reported mean acceleration relative to
+  // up_axis (a normal accelerometer at rest reports the specific force, up).
+  const Eigen::Vector3d up = UpAxisVector(options_.up_axis);
+  SpecificForceDirection direction = SpecificForceDirection::kUndetermined;
+  double angle_deg = 0.0;
+  if (options_.up_axis != ImuUpAxis::kNone && raw_norm > 0.0) {
+    const double c = std::clamp(stats.mean_accel.dot(up) / raw_norm, -1.0, 1.0);
+    angle_deg = std::acos(c) * 180.0 / M_PI;
+    if (angle_deg <= options_.max_up_axis_angle_deg) {
+      direction = SpecificForceDirection::kUp;
+    } else if (angle_deg >= 180.0 - options_.max_up_axis_angle_deg) {
+      direction = SpecificForceDirection::kDown;
+    }
+  }
+  int sign = options_.acceleration_sign;
+  const bool sign_detected = sign == 0;
+  std::string sign_warning;
+  {
+    std::ostringstream os;
+    os << "the mean acceleration at rest points " << config::EnumToString(direction) << " ("
+       << angle_deg << " deg from up_axis " << config::EnumToString(options_.up_axis) << ")";
+    const std::string seen = os.str();
+    if (sign_detected) {
+      if (direction == SpecificForceDirection::kUndetermined) {
+        sign = 1;
+        sign_warning = seen + ": cannot tell the accelerometer sign, assumed +1; set "
+                              "imu_init.acceleration_sign (+1 or -1) or imu_init.up_axis";
+      } else {
+        sign = direction == SpecificForceDirection::kDown ? -1 : 1;
+      }
+    } else if (direction == SpecificForceDirection::kDown && sign == 1) {
+      sign_warning = seen + ", gravity comes out opposite to the configured sign: the driver "
+                            "reports -(specific force) (or the IMU is mounted with up_axis "
+                            "down); set imu_init.acceleration_sign: -1 (or 0 = auto; replay "
+                            "manifest: odometry: {imu_init: {acceleration_sign: 0}}), or "
+                            "imu_init.up_axis to the IMU's up axis";
+    } else if (direction == SpecificForceDirection::kUp && sign == -1) {
+      sign_warning = seen + ", gravity comes out opposite to the configured sign -1: the driver "
+                            "reports the specific force; set imu_init.acceleration_sign: 1 (or "
+                            "0 = auto), or imu_init.up_axis to the IMU's up axis";
+    }
+  }
+  const double factor = sign * unit_factor;
 
   // 2. Static test on the window (standard deviations in SI units).
   const double gyro_std = std::sqrt(stats.cov_gyro.trace());
@@ -198,6 +278,11 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   r.num_samples = static_cast<int>(window_.size());
   r.gyro_stddev_rad_s = gyro_std;
   r.accel_stddev_m_s2 = accel_std;
+  r.reported_direction = direction;
+  r.angle_to_up_axis_deg = angle_deg;
+  r.acceleration_sign = sign;
+  r.sign_detected = sign_detected;
+  r.sign_warning = sign_warning;
 
   // 5. Covariance (docs/imu.md): pose/velocity floors, standard error of the
   // gyro mean, the b_a prior, and gravity = -b_a + noise of the acc mean

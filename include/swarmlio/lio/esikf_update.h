@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "factors/point_to_plane_factor.h"
+#include "factors/pose_information_factor.h"
 #include "swarmlio/lio/measurement_model.h"
 #include "swarmlio/config/option_fields.h"
 #include "swarmlio/common/status.h"
@@ -140,7 +141,8 @@ class PlaneMeasurementModel final : public MeasurementModel {
  private:
   PlaneAssociationFn associate_;
   std::vector<PlaneCorrespondence> correspondences_;
-  PointToPlaneFactor factor_;
+  PointToPlaneFactor factor_;         // the point rows (normal equations, posterior)
+  PoseInformationFactor compressed_;  // what the Ceres problem holds (6 rows)
 };
 
 }  // namespace swarmlio

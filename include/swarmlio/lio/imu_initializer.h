@@ -6,7 +6,9 @@
 //   - the global frame G := the IMU frame at the last sample of the window, so
 //     R_G_b = I and p_b_in_G = v_b_in_G = 0;
 //   - gyro bias b_g = mean angular rate [rad/s];
-//   - gravity g_in_G = -s * k * mean(a_m) [m/s^2], s = acceleration_sign,
+//   - gravity g_in_G = -s * k * mean(a_m) [m/s^2], s = acceleration_sign (or,
+//     with acceleration_sign 0, detected from the direction of mean(a_m)
+//     relative to up_axis: up = +1, down = -1),
 //     k = 1 (m/s^2) or nominal_gravity_m_s2 (g units). Its magnitude |g_in_G|
 //     is measured, not assumed;
 //   - accelerometer bias b_a = 0: it is not observable at a static start (it
@@ -37,6 +39,21 @@ namespace swarmlio {
 /// detected from |mean a_m| at the static start (~1 -> g, ~9.8 -> m/s^2).
 enum class AccelerationUnitSetting { kMetersPerSecondSquared, kStandardGravity, kAuto };
 
+/// The IMU axis that points (roughly) up at the static start, in the IMU
+/// frame: the reference for telling a normal accelerometer (specific force
+/// up) from a sign-flipped driver (down). kNone: no reference.
+enum class ImuUpAxis { kNone, kPlusX, kMinusX, kPlusY, kMinusY, kPlusZ, kMinusZ };
+
+/// Direction of the reported mean acceleration at rest, relative to up_axis.
+enum class SpecificForceDirection {
+  kUp,            // within max_up_axis_angle_deg of up_axis: normal (specific force)
+  kDown,          // within that angle of -up_axis: sign-flipped driver (or upside down)
+  kUndetermined,  // neither (tilted mount), or up_axis none
+};
+
+/// Unit vector of `axis` (zero for kNone).
+Eigen::Vector3d UpAxisVector(ImuUpAxis axis);
+
 }  // namespace swarmlio
 
 namespace swarmlio::config {
@@ -50,6 +67,28 @@ struct EnumTraits<AccelerationUnitSetting> {
   }};
 };
 
+template <>
+struct EnumTraits<ImuUpAxis> {
+  static constexpr std::array<std::pair<ImuUpAxis, const char*>, 7> kNames{{
+      {ImuUpAxis::kNone, "none"},
+      {ImuUpAxis::kPlusX, "+x"},
+      {ImuUpAxis::kMinusX, "-x"},
+      {ImuUpAxis::kPlusY, "+y"},
+      {ImuUpAxis::kMinusY, "-y"},
+      {ImuUpAxis::kPlusZ, "+z"},
+      {ImuUpAxis::kMinusZ, "-z"},
+  }};
+};
+
+template <>
+struct EnumTraits<SpecificForceDirection> {
+  static constexpr std::array<std::pair<SpecificForceDirection, const char*>, 3> kNames{{
+      {SpecificForceDirection::kUp, "up"},
+      {SpecificForceDirection::kDown, "down"},
+      {SpecificForceDirection::kUndetermined, "undetermined"},
+  }};
+};
+
 }  // namespace swarmlio::config
 
 namespace swarmlio {
@@ -59,7 +98,11 @@ struct ImuInitializerOptions {
   int window_num_samples = 200;
   double window_duration_s = 0.0;  // > 0: average over this duration instead [s]
   AccelerationUnitSetting acceleration_unit = AccelerationUnitSetting::kAuto;
-  int acceleration_sign = 1;  // +1: device reports specific force (a - g); -1: it reports -(a - g)
+  // +1: device reports specific force (a - g); -1: it reports -(a - g); 0: auto, from the
+  // direction of the mean acceleration at rest relative to up_axis (+1 when undetermined).
+  int acceleration_sign = 1;
+  ImuUpAxis up_axis = ImuUpAxis::kPlusZ;  // IMU axis pointing up at rest (REP 103: +z)
+  double max_up_axis_angle_deg = 60.0;    // tilt of up_axis from vertical still judged [deg]
   // Converts g units to m/s^2; reference of the magnitude check [m/s^2].
   double nominal_gravity_m_s2 = 9.81;
   double max_gravity_error_ratio = 0.1;  // | |g| / nominal - 1 | allowed after unit conversion
@@ -85,7 +128,16 @@ struct ImuInitializerOptions {
     v("acceleration_unit", acceleration_unit,
       FieldSpec::Doc("unit of the reported acceleration: m_s2, g or auto (detected at rest)"));
     v("acceleration_sign", acceleration_sign,
-      FieldSpec::InRange(-1.0, 1.0, "", "+1: specific force (a - g); -1: device reports -(a - g)"));
+      FieldSpec::InRange(-1.0, 1.0, "",
+                         "+1: specific force (a - g); -1: device reports -(a - g); 0: auto "
+                         "(from the static start and up_axis)"));
+    v("up_axis", up_axis,
+      FieldSpec::Doc("IMU axis that points up at the static start (+x, -x, +y, -y, +z, -z, "
+                     "none): tells a normal accelerometer from a sign-flipped one"));
+    v("max_up_axis_angle_deg", max_up_axis_angle_deg,
+      FieldSpec::InRange(1.0, 89.0, "deg",
+                         "largest angle between the mean acceleration at rest and +-up_axis "
+                         "for which the direction counts as up or down"));
     v("nominal_gravity_m_s2", nominal_gravity_m_s2,
       FieldSpec::InRange(9.7, 9.9, "m/s^2", "g-unit conversion and magnitude-check reference"));
     v("max_gravity_error_ratio", max_gravity_error_ratio,
@@ -129,6 +181,15 @@ struct ImuInitialization {
   int num_samples = 0;
   double gyro_stddev_rad_s = 0.0;  // sqrt(trace Cov(w_m)) over the window
   double accel_stddev_m_s2 = 0.0;  // sqrt(trace Cov(a_m)) over the window, in m/s^2
+  // Accelerometer sign: the reported mean acceleration at rest points up
+  // (normal) or down (sign-flipped driver) relative to the options' up_axis.
+  SpecificForceDirection reported_direction = SpecificForceDirection::kUndetermined;
+  double angle_to_up_axis_deg = 0.0;  // angle between the reported mean acc and up_axis
+  int acceleration_sign = 1;          // used: configured, or detected (acceleration_sign: 0)
+  bool sign_detected = false;         // true when acceleration_sign came from auto (0)
+  /// Non-empty when the data contradict the configured sign (or auto could
+  /// not decide): what was seen and the option to set. The caller shows it.
+  std::string sign_warning;
 
   /// One-line human-readable report (the library does not print it).
   std::string Summary() const;
