@@ -141,6 +141,7 @@ class BagReader::Impl {
     bool exhausted = false;
     std::optional<BagRecord> pending;
     bool pending_without_point_time = false;
+    bool pending_time_from_azimuth = false;
     bool has_last_stamp = false;
     int64_t last_stamp_ns = 0;
     int64_t message_index = -1;  // index within the topic of the last message read
@@ -158,6 +159,12 @@ class BagReader::Impl {
   // Decodes and checks one message; sets stream->pending when the record is
   // delivered, leaves it empty when skipped.
   Status Consume(TopicStream* stream, const internal::SourceMessage& message);
+  // True when scans without a per-point time field get it from azimuth.
+  bool ReconstructFromAzimuth() const {
+    return options_.reconstruct_point_time == PointTimeReconstruction::kAzimuth ||
+           (options_.reconstruct_point_time == PointTimeReconstruction::kAuto &&
+            options_.spinning_lidar);
+  }
   Status Malformed(const TopicStream& stream,
                    const internal::SourceMessage& message,
                    const Status& cause);
@@ -319,7 +326,8 @@ Status BagReader::Impl::Open() {
   if (!ground_truth_topic_.empty()) {
     SWARMLIO_RETURN_IF_ERROR(CheckTopic(StreamKind::kGroundTruth, ground_truth_topic_));
   }
-  if (options_.check_point_time_span && lidar_type_ == LidarMessageType::kPointCloud2) {
+  if ((options_.check_point_time_span || ReconstructFromAzimuth()) &&
+      lidar_type_ == LidarMessageType::kPointCloud2) {
     std::vector<int64_t> times;
     SWARMLIO_RETURN_IF_ERROR(source_->TopicTimes(lidar_topic_, kScanPeriodSamples, &times));
     scan_period_s_ = internal::EstimateScanPeriodS(times);
@@ -429,15 +437,26 @@ Status BagReader::Impl::Consume(TopicStream* stream, const internal::SourceMessa
         }
       }
       if (!AcceptStamp(stream, scan.stamp_ns, SkipReason::kScanNonMonotonic)) return Status::Ok();
+      bool from_azimuth = false;
+      if (without_point_time && ReconstructFromAzimuth()) {
+        from_azimuth = internal::ReconstructPointTimeFromAzimuth(scan_period_s_, &scan).reconstructed;
+      }
       if (without_point_time && !warned_no_point_time_) {
         warned_no_point_time_ = true;
         LOG(WARNING) << "bag '" << path_ << "' topic '" << stream->topic
                      << "': PointCloud2 has no per-point time field (tried "
                      << (options_.point_time_field.empty() ? "time, t, timestamp, offset_time"
                                                            : options_.point_time_field)
-                     << "); reading each scan as one instant (all offsets 0)";
+                     << "); "
+                     << (ReconstructFromAzimuth()
+                             ? "reconstructing it from azimuth over the scan period " +
+                                   std::to_string(scan_period_s_) + " s"
+                             : std::string("reading each scan as one instant (all offsets 0; "
+                                           "a spinning LiDAR: set spinning_lidar or "
+                                           "reconstruct_point_time: azimuth)"));
       }
       stream->pending_without_point_time = without_point_time;
+      stream->pending_time_from_azimuth = from_azimuth;
       stream->pending.emplace(BagRecord{std::move(scan)});
       return Status::Ok();
     }
@@ -508,6 +527,7 @@ Status BagReader::Impl::Next(BagRecord* record, bool* has_record) {
       ++stats_.scans;
       stats_.points += static_cast<int64_t>(record->scan()->points.size());
       if (best->pending_without_point_time) ++stats_.scans_without_point_time;
+      if (best->pending_time_from_azimuth) ++stats_.scans_point_time_from_azimuth;
       break;
     case StreamKind::kGroundTruth:
       ++stats_.ground_truth_poses;

@@ -80,7 +80,10 @@ class BagWriter::Impl {
       sensor_msgs::PointCloud2 msg;
       SWARMLIO_RETURN_IF_ERROR(internal::EncodePointCloud2(scan, scan_seq_,
                                                            options_.point_time_unit,
-                                                           options_.point_time_field, &msg)
+                                                           options_.write_point_time
+                                                               ? options_.point_time_field
+                                                               : std::string(),
+                                                           &msg)
                                    .WithContext(context));
       SWARMLIO_RETURN_IF_ERROR(Write(options_.lidar_topic, record_time_ns, msg));
     }

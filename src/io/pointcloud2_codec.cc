@@ -2,6 +2,7 @@
 
 #include <sensor_msgs/PointField.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -279,10 +280,10 @@ Status EncodePointCloud2(const LidarScan& scan,
   msg->fields = {MakeField("x", 0, PointField::FLOAT32),
                  MakeField("y", 4, PointField::FLOAT32),
                  MakeField("z", 8, PointField::FLOAT32),
-                 MakeField("intensity", 12, PointField::FLOAT32),
-                 MakeField(time_field, 16, PointField::FLOAT64),
-                 MakeField("tag", 24, PointField::UINT8),
-                 MakeField("line", 25, PointField::UINT8)};
+                 MakeField("intensity", 12, PointField::FLOAT32)};
+  if (!time_field.empty()) msg->fields.push_back(MakeField(time_field, 16, PointField::FLOAT64));
+  msg->fields.push_back(MakeField("tag", 24, PointField::UINT8));
+  msg->fields.push_back(MakeField("line", 25, PointField::UINT8));
   const uint32_t n = static_cast<uint32_t>(scan.points.size());
   msg->height = 1;
   msg->width = n;
@@ -299,13 +300,76 @@ Status EncodePointCloud2(const LidarScan& scan,
     Store(p + 4, point.y);
     Store(p + 8, point.z);
     Store(p + 12, point.reflectivity);
-    Store(p + 16, point.offset_time_s * ticks_per_s);
+    if (!time_field.empty()) Store(p + 16, point.offset_time_s * ticks_per_s);
     p[24] = point.tag;
     p[25] = point.line;
     dense = dense && std::isfinite(point.x) && std::isfinite(point.y) && std::isfinite(point.z);
   }
   msg->is_dense = dense;
   return Status::Ok();
+}
+
+AzimuthTimeInfo ReconstructPointTimeFromAzimuth(double scan_period_s, LidarScan* scan) {
+  AzimuthTimeInfo info;
+  constexpr double kTwoPi = 2.0 * M_PI;
+  constexpr double kMinRadius = 1e-6;  // points on the rotation axis have no azimuth [m]
+  constexpr int kRings = 256;          // LidarPoint::line is a byte
+  std::vector<LidarPoint>& points = scan->points;
+  std::vector<double> azimuth(points.size(), 0.0);
+  std::vector<bool> valid(points.size(), false);
+  std::vector<double> steps;
+  steps.reserve(points.size());
+  std::array<int, kRings> previous;
+  previous.fill(-1);
+  int first = -1;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double x = points[i].x, y = points[i].y;
+    if (!(std::hypot(x, y) > kMinRadius)) continue;
+    valid[i] = true;
+    azimuth[i] = std::atan2(y, x);
+    if (first < 0) first = static_cast<int>(i);
+    int& prev = previous[points[i].line];
+    if (prev >= 0) {
+      // Step to the previous point of the same ring, wrapped to (-pi, pi].
+      const double step = std::remainder(azimuth[i] - azimuth[prev], kTwoPi);
+      if (step != 0.0) steps.push_back(step);
+    }
+    prev = static_cast<int>(i);
+  }
+  for (LidarPoint& p : points) p.offset_time_s = 0.0;
+  if (first < 0 || steps.empty()) return info;
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  info.direction = steps[steps.size() / 2] < 0.0 ? -1 : 1;
+  info.reconstructed = true;
+  // Per ring, the time of its latest point: a point that seems more than half
+  // a turn ahead of it is slightly behind (clamped to it), one more than half
+  // a turn behind it has wrapped past a full turn (a period added).
+  std::array<double, kRings> last_t;
+  last_t.fill(0.0);
+  const double half = 0.5 * scan_period_s;
+  double t_previous = 0.0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!valid[i]) {
+      points[i].offset_time_s = t_previous;  // no azimuth: the previous point's time
+      continue;
+    }
+    double swept = std::fmod(info.direction * (azimuth[i] - azimuth[first]), kTwoPi);
+    if (swept < 0.0) swept += kTwoPi;  // [0, 2 pi)
+    double t = swept / kTwoPi * scan_period_s;
+    double& last = last_t[points[i].line];
+    if (t - last > half) {
+      t = last;
+    } else if (last - t > half) {
+      t += scan_period_s;
+      last = t;
+    } else {
+      last = std::max(last, t);
+    }
+    points[i].offset_time_s = t;
+    t_previous = t;
+    info.span_s = std::max(info.span_s, t);
+  }
+  return info;
 }
 
 }  // namespace swarmlio::io::internal

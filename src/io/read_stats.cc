@@ -55,11 +55,27 @@ std::string ReadStats::ToString() const {
      << "scans: " << scans << "\n"
      << "points: " << points << "\n"
      << "ground_truth_poses: " << ground_truth_poses << "\n"
-     << "scans_without_point_time: " << scans_without_point_time << "\n";
+     << "scans_without_point_time: " << scans_without_point_time << "\n"
+     << "scans_point_time_from_azimuth: " << scans_point_time_from_azimuth << "\n";
   for (size_t i = 0; i < kNumSkipReasons; ++i) {
     os << "skipped." << SkipReasonName(static_cast<SkipReason>(i)) << ": " << skipped[i] << "\n";
   }
   if (recovery.recovered) os << "recovery: " << recovery.Summary() << "\n";
+  return os.str();
+}
+
+std::string ReadStats::PointTimeSummary() const {
+  if (scans_without_point_time == 0) return "per-point time field";
+  const int64_t instant = scans_without_point_time - scans_point_time_from_azimuth;
+  std::ostringstream os;
+  if (scans_point_time_from_azimuth > 0) {
+    os << "reconstructed from azimuth (" << scans_point_time_from_azimuth
+       << " scans without a time field)";
+    if (instant > 0) os << "; ";
+  }
+  if (instant > 0) {
+    os << "none: " << instant << " scans without a time field read as one instant";
+  }
   return os.str();
 }
 

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "swarmlio/math/so3.h"
 
@@ -29,6 +30,92 @@ bool InterpolatePose(const std::vector<PoseStamped>& gt, int64_t stamp_ns, int64
   pose->p_b_in_G = (1.0 - w) * a.p_b_in_G + w * b.p_b_in_G;
   pose->q_G_b = a.q_G_b.slerp(w, b.q_G_b);
   return true;
+}
+
+std::string FrameCheck::Summary() const {
+  std::ostringstream os;
+  os.precision(3);
+  if (same_frame) {
+    os << "ground truth in G";
+    if (declared) os << " (declared)";
+    if (compared) {
+      os << (declared ? ", " : " (") << "first pose within " << position_offset_m << " m, "
+         << rotation_offset_deg << " deg" << (declared ? "" : ")");
+    }
+    return os.str();
+  }
+  os << "ground truth in another frame: aligned by first pose and SE(3)";
+  if (declared) os << " (declared)";
+  if (compared) {
+    os << (declared ? ", " : " (") << "first pose " << position_offset_m << " m, "
+       << rotation_offset_deg << " deg from the estimate's" << (declared ? "" : ")");
+  }
+  return os.str();
+}
+
+Status CheckGroundTruthFrame(const std::vector<ScanRecord>& scans,
+                             const std::vector<PoseStamped>& gt, GroundTruthFrame declared,
+                             const FrameCheckOptions& options, FrameCheck* check) {
+  FrameCheck c;
+  c.declared = declared != GroundTruthFrame::kAuto;
+  const int64_t max_gap_ns = static_cast<int64_t>(std::llround(options.max_gt_gap_s * 1e9));
+  for (const ScanRecord& r : scans) {
+    if (!r.updated) continue;
+    PoseStamped truth;
+    if (!InterpolatePose(gt, r.stamp_ns, max_gap_ns, &truth)) continue;
+    c.compared = true;
+    c.stamp_ns = r.stamp_ns;
+    c.position_offset_m = (truth.p_b_in_G - r.state.p_b_in_G).norm();
+    c.rotation_offset_deg =
+        so3::Log(truth.q_G_b.normalized().conjugate() * r.state.q_G_b.normalized()).norm() *
+        180.0 / M_PI;
+    break;
+  }
+  if (declared == GroundTruthFrame::kG) {
+    c.same_frame = true;
+  } else if (declared == GroundTruthFrame::kAuto) {
+    if (!c.compared) {
+      return Status::FailedPrecondition("no estimated pose overlaps the ground truth");
+    }
+    c.same_frame = c.position_offset_m <= options.max_position_offset_m &&
+                   c.rotation_offset_deg <= options.max_rotation_offset_deg;
+  }
+  *check = c;
+  return Status::Ok();
+}
+
+Status AlignGroundTruthByFirstPose(const std::vector<ScanRecord>& scans,
+                                   const std::vector<PoseStamped>& gt, const FrameCheck& check,
+                                   double max_gt_gap_s, std::vector<PoseStamped>* aligned) {
+  if (!check.compared) {
+    return Status::FailedPrecondition("no estimated pose overlaps the ground truth");
+  }
+  const ScanRecord* first = nullptr;
+  for (const ScanRecord& r : scans) {
+    if (r.stamp_ns == check.stamp_ns) {
+      first = &r;
+      break;
+    }
+  }
+  PoseStamped truth;
+  const int64_t max_gap_ns = static_cast<int64_t>(std::llround(max_gt_gap_s * 1e9));
+  if (first == nullptr || !InterpolatePose(gt, check.stamp_ns, max_gap_ns, &truth)) {
+    return Status::FailedPrecondition("the first-pose stamp of the frame check is not in the "
+                                      "estimate or the ground truth");
+  }
+  // T_G_W = T_G_b(t0) * T_W_b(t0)^-1.
+  const Eigen::Quaterniond q_G_W =
+      first->state.q_G_b.normalized() * truth.q_G_b.normalized().conjugate();
+  const Eigen::Vector3d p_W_in_G = first->state.p_b_in_G - q_G_W * truth.p_b_in_G;
+  aligned->clear();
+  aligned->reserve(gt.size());
+  for (const PoseStamped& p : gt) {
+    PoseStamped a = p;
+    a.q_G_b = (q_G_W * p.q_G_b.normalized()).normalized();
+    a.p_b_in_G = q_G_W * p.p_b_in_G + p_W_in_G;
+    aligned->push_back(a);
+  }
+  return Status::Ok();
 }
 
 Status EvaluateConsistency(const std::vector<ScanRecord>& scans,

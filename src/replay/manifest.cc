@@ -19,6 +19,7 @@ struct DroneEntry {
   std::string name;
   std::string bag;
   std::string ground_truth;
+  GroundTruthFrame ground_truth_frame = GroundTruthFrame::kAuto;
   std::string sensor_preset;
   LidarOptions lidar;
   ImuOptions imu;
@@ -35,6 +36,10 @@ struct DroneEntry {
     v("bag", bag, FieldSpec::Doc("ROS1 bag, relative to the manifest's folder"));
     v("ground_truth", ground_truth,
       FieldSpec::Doc("TUM ground-truth file, relative to the manifest's folder (optional)"));
+    v("ground_truth_frame", ground_truth_frame,
+      FieldSpec::Doc("frame of the ground truth: G (the estimator's: NEES is reported), other "
+                     "(mocap/simulator world: aligned, no NEES) or auto (G when it starts at "
+                     "the estimate's first pose)"));
     v("sensor_preset", sensor_preset,
       FieldSpec::Doc("sensor preset (lidar: and imu: sections), relative to the manifest"));
     v("lidar", lidar);
@@ -117,6 +122,7 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     d.name = e.name;
     d.bag_path = Resolve(folder, e.bag);
     d.ground_truth_path = Resolve(folder, e.ground_truth);
+    d.ground_truth_frame = e.ground_truth_frame;
     d.bag = e.bag_topics;
     d.p_G_in_W_m = e.p_G_in_W_m;
     d.R_W_G = Eigen::Quaterniond(e.q_W_G_xyzw[3], e.q_W_G_xyzw[0], e.q_W_G_xyzw[1], e.q_W_G_xyzw[2])
@@ -136,6 +142,9 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     d.bag.point_time_unit = file.HasKey(key + ".bag_topics.point_time_unit")
                                 ? d.bag.point_time_unit
                                 : d.lidar.timestamp_unit;
+    if (!file.HasKey(key + ".bag_topics.spinning_lidar")) {
+      d.bag.spinning_lidar = d.lidar.type == LidarType::kSpinning;
+    }
     out.drones.push_back(std::move(d));
   }
   *manifest = std::move(out);
@@ -173,6 +182,7 @@ Status ManifestFromBags(const std::vector<std::string>& bags, const std::string&
     }
     d.odometry = DefaultOdometryOptions(d.lidar, d.imu);
     d.bag.point_time_unit = d.lidar.timestamp_unit;
+    d.bag.spinning_lidar = d.lidar.type == LidarType::kSpinning;
     out.drones.push_back(std::move(d));
   }
   *manifest = std::move(out);

@@ -57,6 +57,14 @@ TEST(DroneMetrics, EvaluatesAndTabulates) {
   EXPECT_NE(csv.find("uav1,5,"), std::string::npos) << csv;
   EXPECT_EQ(csv.substr(csv.size() - 6), ",0,,,\n") << csv;  // rpe cells and extra missing
 
+  // Extra cells may be text (e.g. a metric that does not apply).
+  uav1.extra = {{"update_ms_mean", std::string("n/a (frames differ)")}};
+  ASSERT_TRUE(MakeDroneMetricsTable({uav1}, options, {{"update_ms_mean", "update [ms]", 2}}, &table)
+                  .ok());
+  EXPECT_NE(table.ToMarkdown().find("n/a (frames differ)"), std::string::npos)
+      << table.ToMarkdown();
+  EXPECT_NE(table.ToJson().find("\"n/a (frames differ)\""), std::string::npos) << table.ToJson();
+
   // An extra value without a column is an error.
   uav1.extra = {{"unknown", 1.0}};
   EXPECT_FALSE(MakeDroneMetricsTable({uav1}, options, {}, &table).ok());

@@ -61,7 +61,7 @@ TEST(BagOptionsTest, OptionsAreVisitable) {
   int count = 0;
   BagReaderOptions options;
   options.VisitFields([&count](const char*, auto&, const config::FieldSpec&) { ++count; });
-  EXPECT_EQ(count, 10);
+  EXPECT_EQ(count, 12);  // + reconstruct_point_time, spinning_lidar
 }
 
 TEST(BagOptionsTest, EmptyOrAutoTopicsAreValid) {

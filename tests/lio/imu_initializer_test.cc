@@ -157,6 +157,73 @@ TEST(ImuInitializer, NegativeSignConventionNeedsTheOption) {
   EXPECT_LT((r.state.g_in_G - imu.SpecificForce()).norm(), 0.02);
 }
 
+// The sign at rest relative to up_axis (+z; the test IMU is tilted ~23 deg):
+// always reported; a contradiction is a warning naming the option; auto (0)
+// picks the sign from the data.
+TEST(ImuInitializer, DetectsTheAccelerometerSignFromTheStaticStart) {
+  std::mt19937 rng(15);
+  StaticImu normal;
+  StaticImu flipped;
+  flipped.scale = -1.0;
+  ImuInitialization r;
+
+  auto init = Make();  // +1 configured, normal data: up, no warning
+  Feed(init.get(), normal, 200, rng);
+  ASSERT_TRUE(init->Initialize(&r).ok());
+  EXPECT_EQ(r.reported_direction, SpecificForceDirection::kUp);
+  EXPECT_LT(r.angle_to_up_axis_deg, 40.0);
+  EXPECT_EQ(r.acceleration_sign, 1);
+  EXPECT_FALSE(r.sign_detected);
+  EXPECT_TRUE(r.sign_warning.empty()) << r.sign_warning;
+  EXPECT_NE(r.Summary().find("points up (normal)"), std::string::npos) << r.Summary();
+
+  init = Make();  // +1 configured, flipped data: down, warning naming the option
+  Feed(init.get(), flipped, 200, rng);
+  ASSERT_TRUE(init->Initialize(&r).ok());
+  EXPECT_EQ(r.reported_direction, SpecificForceDirection::kDown);
+  EXPECT_GT(r.angle_to_up_axis_deg, 140.0);
+  EXPECT_EQ(r.acceleration_sign, 1);
+  EXPECT_NE(r.sign_warning.find("acceleration_sign: -1"), std::string::npos) << r.sign_warning;
+  EXPECT_NE(r.sign_warning.find("opposite"), std::string::npos) << r.sign_warning;
+  EXPECT_NE(r.Summary().find("WARNING"), std::string::npos) << r.Summary();
+  EXPECT_NE(r.Summary().find("down (sign-flipped driver)"), std::string::npos) << r.Summary();
+
+  ImuInitializerOptions options;
+  options.acceleration_sign = -1;  // -1 configured, normal data: warning the other way
+  init = Make(options);
+  Feed(init.get(), normal, 200, rng);
+  ASSERT_TRUE(init->Initialize(&r).ok());
+  EXPECT_NE(r.sign_warning.find("acceleration_sign: 1"), std::string::npos) << r.sign_warning;
+
+  options.acceleration_sign = 0;  // auto: flipped data get -1, gravity points down again
+  init = Make(options);
+  Feed(init.get(), flipped, 200, rng);
+  ASSERT_TRUE(init->Initialize(&r).ok());
+  EXPECT_TRUE(r.sign_detected);
+  EXPECT_EQ(r.acceleration_sign, -1);
+  EXPECT_EQ(r.acceleration_to_m_s2, -1.0);
+  EXPECT_TRUE(r.sign_warning.empty()) << r.sign_warning;
+  EXPECT_LT((r.state.g_in_G + flipped.SpecificForce() * 1.0).norm(), 0.02);
+  EXPECT_NE(r.Summary().find("-1 (detected)"), std::string::npos) << r.Summary();
+
+  init = Make(options);  // auto, normal data: +1
+  Feed(init.get(), normal, 200, rng);
+  ASSERT_TRUE(init->Initialize(&r).ok());
+  EXPECT_EQ(r.acceleration_sign, 1);
+  EXPECT_LT((r.state.g_in_G + normal.SpecificForce()).norm(), 0.02);
+
+  // A sideways mount (up_axis +x, gravity along z): auto cannot tell, assumes
+  // +1 and says which option to set.
+  options.up_axis = ImuUpAxis::kPlusX;
+  init = Make(options);
+  Feed(init.get(), normal, 200, rng);
+  ASSERT_TRUE(init->Initialize(&r).ok());
+  EXPECT_EQ(r.reported_direction, SpecificForceDirection::kUndetermined);
+  EXPECT_EQ(r.acceleration_sign, 1);
+  EXPECT_NE(r.sign_warning.find("imu_init.acceleration_sign"), std::string::npos)
+      << r.sign_warning;
+}
+
 TEST(ImuInitializer, RefusesAMovingStartWithTheMeasuredSpread) {
   std::mt19937 rng(6);
   StaticImu imu;
@@ -224,7 +291,7 @@ TEST(ImuInitializer, DurationWindow) {
 TEST(ImuInitializer, OptionsAreValidated) {
   std::unique_ptr<ImuInitializer> init;
   ImuInitializerOptions options;
-  options.acceleration_sign = 0;
+  options.acceleration_sign = 2;  // 0 is auto
   Status s = ImuInitializer::Create(options, &init);
   EXPECT_EQ(s.code(), Status::Code::kInvalidArgument);
   EXPECT_NE(s.message().find("acceleration_sign"), std::string::npos) << s.message();

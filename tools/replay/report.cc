@@ -130,7 +130,7 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
     const double log_s = d.scans().size() < 2 ? 0.0
                                               : StampSeconds(d.scans().back().stamp_ns -
                                                              d.scans().front().stamp_ns);
-    std::vector<std::pair<std::string, double>> extra = {{"scans", static_cast<double>(d.scans().size())},
+    std::vector<std::pair<std::string, eval::MetricsValue>> extra = {{"scans", static_cast<double>(d.scans().size())},
                {"time_median_ms", eval::Percentile(total_ms, 0.5)},
                {"time_p95_ms", eval::Percentile(total_ms, 0.95)},
                {"realtime_factor", busy_s > 0.0 ? log_s / busy_s : 0.0}};
@@ -159,9 +159,23 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
         series.reference_positions = ToWorld(d.input(), series.reference_positions);
         top_view.push_back(std::move(series));
         errors.push_back(eval::ErrorSeriesFromApe(name, ape));
-        replay::ConsistencyStats consistency;
-        if (replay::EvaluateConsistency(d.scans(), ToPoses(reference), 0.05, &consistency).ok()) {
-          extra.push_back({"nees_position", consistency.mean_position_nees});
+        // NEES only when the ground truth is in the estimator's G (declared, or
+        // starting at the estimate's first pose): in another frame it is meaningless.
+        const std::vector<PoseStamped> truth = ToPoses(reference);
+        replay::FrameCheck frame;
+        if (replay::CheckGroundTruthFrame(d.scans(), truth, d.input().ground_truth_frame,
+                                          replay::FrameCheckOptions(), &frame)
+                .ok()) {
+          extra.push_back({"ground_truth_frame",
+                           std::string(frame.same_frame
+                                           ? "G"
+                                           : "other: aligned by first pose and SE(3)")});
+          replay::ConsistencyStats consistency;
+          if (!frame.same_frame) {
+            extra.push_back({"nees_position", std::string("n/a (frames differ)")});
+          } else if (replay::EvaluateConsistency(d.scans(), truth, 0.05, &consistency).ok()) {
+            extra.push_back({"nees_position", consistency.mean_position_nees});
+          }
         }
       }
     }
@@ -176,6 +190,7 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
       {"time_median_ms", "time median [ms]", 2},
       {"time_p95_ms", "time p95 [ms]", 2},
       {"realtime_factor", "real-time factor", 1},
+      {"ground_truth_frame", "ground-truth frame", 0},
       {"nees_position", "position NEES (3 expected)", 2}};
   extra_columns.push_back({"messages_received", "msgs received", 0});
   eval::MetricsTable table;

@@ -81,6 +81,10 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     std::printf("  IMU never initialized: %s\n", d.odometry().initialization_error().c_str());
   } else {
     std::printf("  IMU init: %s\n", d.odometry().initialization().Summary().c_str());
+    if (!d.odometry().initialization().sign_warning.empty()) {
+      std::printf("  WARNING (IMU sign): %s\n",
+                  d.odometry().initialization().sign_warning.c_str());
+    }
   }
   if (!total.empty()) {
     std::printf("  per-scan time [ms]: median %.2f  p95 %.2f  max %.2f", eval::Percentile(total, 0.5),
@@ -111,14 +115,35 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
                 log_s, busy_s, busy_s > 0 ? log_s / busy_s : 0.0, wall_s);
   }
   if (!d.bag_ground_truth().empty()) {
+    // NEES only when the ground truth is known to be in G (docs/replay.md).
+    replay::FrameCheck frame;
     replay::ConsistencyStats cs;
-    const Status status = replay::EvaluateConsistency(d.scans(), d.bag_ground_truth(), 0.05, &cs);
+    std::vector<PoseStamped> aligned;
+    Status status = replay::CheckGroundTruthFrame(d.scans(), d.bag_ground_truth(),
+                                                  d.input().ground_truth_frame,
+                                                  replay::FrameCheckOptions(), &frame);
+    if (status.ok() && !frame.same_frame) {
+      status = replay::AlignGroundTruthByFirstPose(d.scans(), d.bag_ground_truth(), frame, 0.05,
+                                                   &aligned);
+    }
     if (status.ok()) {
-      std::printf("  vs bag ground truth (same frame, no alignment), %d poses: position RMSE "
-                  "%.4f m (max %.4f), rotation RMSE %.3f deg, mean position NEES %.2f "
-                  "(expected %.0f)\n",
+      status = replay::EvaluateConsistency(
+          d.scans(), frame.same_frame ? d.bag_ground_truth() : aligned, 0.05, &cs);
+    }
+    if (status.ok()) {
+      std::printf("  %s\n", frame.Summary().c_str());
+      char nees[64];
+      if (frame.same_frame) {
+        std::snprintf(nees, sizeof(nees), "%.2f (expected %.0f)", cs.mean_position_nees,
+                      cs.expected_position_nees);
+      } else {
+        std::snprintf(nees, sizeof(nees), "n/a (frames differ)");
+      }
+      std::printf("  vs bag ground truth (%s), %d poses: position RMSE %.4f m (max %.4f), "
+                  "rotation RMSE %.3f deg, mean position NEES %s\n",
+                  frame.same_frame ? "same frame, no alignment" : "aligned by first pose",
                   cs.num_poses, cs.position_rmse_m, cs.position_max_m, cs.rotation_rmse_deg,
-                  cs.mean_position_nees, cs.expected_position_nees);
+                  nees);
     } else {
       std::printf("  ground truth: %s\n", status.message().c_str());
     }
@@ -132,6 +157,9 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
               d.reader().lidar_topic().c_str(),
               d.reader().ground_truth_topic().empty() ? "(none)"
                                                       : d.reader().ground_truth_topic().c_str());
+  if (d.reader().lidar_message_type() == io::LidarMessageType::kPointCloud2) {
+    std::printf("  point time: %s\n", rs.PointTimeSummary().c_str());
+  }
   if (rs.recovery.recovered) std::printf("  damaged bag: %s\n", rs.recovery.Summary().c_str());
   if (rs.TotalSkipped() > 0) {
     std::printf("  bag reader skipped records:\n%s", rs.ToString().c_str());

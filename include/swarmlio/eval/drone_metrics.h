@@ -34,8 +34,9 @@ struct DroneMetrics {
   bool has_rpe = false;
   ErrorStatistics rpe_translation;  // [m]
   std::string rpe_note;
-  /// Caller-supplied numbers, by column key (e.g. {"update_ms_mean", 3.1}).
-  std::vector<std::pair<std::string, double>> extra;
+  /// Caller-supplied values (numbers or text), by column key (e.g.
+  /// {"update_ms_mean", 3.1}, {"nees_position", std::string("n/a (frames differ)")}).
+  std::vector<std::pair<std::string, MetricsValue>> extra;
 };
 
 /// Evaluates one drone. `ape` (optional) receives the full APE result, e.g.

@@ -26,6 +26,12 @@ inline bool IsAutoTopic(const std::string& topic) { return topic.empty() || topi
 /// Message type of written ground-truth poses.
 enum class GroundTruthFormat { kPoseStamped, kOdometry };
 
+/// What to do with a PointCloud2 scan that has no per-point time field.
+///   kAuto:    reconstruct from azimuth when spinning_lidar, else one instant
+///   kAzimuth: reconstruct from azimuth (any sensor)
+///   kNone:    read the scan as one instant (all offsets 0)
+enum class PointTimeReconstruction { kAuto, kAzimuth, kNone };
+
 struct BagReaderOptions {
   // Topics. IMU and LiDAR: "" or "auto" finds the topic by message type, and
   // so does a configured topic that the bag lacks, when exactly one topic of
@@ -39,6 +45,9 @@ struct BagReaderOptions {
   TimestampUnit point_time_unit = TimestampUnit::kMicrosecond;
   std::string point_time_field;          // "" = auto: "time", "t", "timestamp", "offset_time"
   bool check_point_time_span = true;     // a per-point time span that cannot be a scan: error
+  // Clouds without a per-point time field (docs/bag_format.md).
+  PointTimeReconstruction reconstruct_point_time = PointTimeReconstruction::kAuto;
+  bool spinning_lidar = false;  // the LiDAR spins (lidar.type: spinning; set by the manifest)
   bool skip_malformed_messages = false;  // false: a malformed message is an error
   bool verify_chunks = true;             // check every chunk's records on open (one extra pass)
   bool recover_damaged_bags = true;      // read truncated / unindexed bags by a record scan
@@ -65,6 +74,15 @@ struct BagReaderOptions {
       config::FieldSpec::Doc("fail when a scan's per-point times span far more (or, with a "
                              "coarser unit fitting, far less) than the scan period in "
                              "point_time_unit: a wrong unit"));
+    v("reconstruct_point_time", reconstruct_point_time,
+      config::FieldSpec::Doc("PointCloud2 without a per-point time field: auto (from azimuth "
+                             "when spinning_lidar, else one instant), azimuth (time = azimuth "
+                             "swept since the first point / 360 deg * scan period) or none "
+                             "(one instant)"));
+    v("spinning_lidar", spinning_lidar,
+      config::FieldSpec::Doc("the LiDAR is a spinning one (the replay manifest sets it from "
+                             "lidar.type: spinning); selects azimuth for reconstruct_point_time: "
+                             "auto"));
     v("skip_malformed_messages", skip_malformed_messages,
       config::FieldSpec::Doc("skip and count undecodable messages instead of failing"));
     v("verify_chunks", verify_chunks,
@@ -88,6 +106,7 @@ struct BagWriterOptions {
   LidarMessageFormat lidar_format = LidarMessageFormat::kLivoxCustomMsg;
   TimestampUnit point_time_unit = TimestampUnit::kMicrosecond;  // PointCloud2 only
   std::string point_time_field = "time";                        // PointCloud2 only
+  bool write_point_time = true;  // PointCloud2 only; false: no per-point time field (old drivers)
   GroundTruthFormat ground_truth_format = GroundTruthFormat::kPoseStamped;
   BagCompression compression = BagCompression::kNone;
 
@@ -101,6 +120,9 @@ struct BagWriterOptions {
       config::FieldSpec::Doc("unit of the written PointCloud2 time field"));
     v("point_time_field", point_time_field,
       config::FieldSpec::Doc("name of the written PointCloud2 time field"));
+    v("write_point_time", write_point_time,
+      config::FieldSpec::Doc("write the PointCloud2 per-point time field (false: clouds without "
+                             "per-point time, as some drivers publish them)"));
     v("ground_truth_format", ground_truth_format,
       config::FieldSpec::Doc("message type of ground-truth poses"));
     v("compression", compression, config::FieldSpec::Doc("bag chunk compression"));
@@ -118,6 +140,15 @@ struct EnumTraits<io::GroundTruthFormat> {
   static constexpr std::array<std::pair<io::GroundTruthFormat, const char*>, 2> kNames{{
       {io::GroundTruthFormat::kPoseStamped, "pose_stamped"},
       {io::GroundTruthFormat::kOdometry, "odometry"},
+  }};
+};
+
+template <>
+struct EnumTraits<io::PointTimeReconstruction> {
+  static constexpr std::array<std::pair<io::PointTimeReconstruction, const char*>, 3> kNames{{
+      {io::PointTimeReconstruction::kAuto, "auto"},
+      {io::PointTimeReconstruction::kAzimuth, "azimuth"},
+      {io::PointTimeReconstruction::kNone, "none"},
   }};
 };
 

@@ -51,6 +51,7 @@ struct ReadStats {
   int64_t points = 0;                              // points in delivered scans
   int64_t ground_truth_poses = 0;                  // delivered poses
   int64_t scans_without_point_time = 0;            // delivered PointCloud2 scans with no time field
+  int64_t scans_point_time_from_azimuth = 0;       // of those, per-point time from azimuth
   std::array<int64_t, kNumSkipReasons> skipped{};  // indexed by SkipReason
   BagRecoveryStats recovery;  // set when the bag was damaged; skipped[kDamagedRecord] mirrors
                               // recovery.damaged_records
@@ -61,6 +62,12 @@ struct ReadStats {
   /// Multi-line human-readable summary (one "name: count" per line, then a
   /// "recovery: ..." line for a damaged bag).
   std::string ToString() const;
+
+  /// How per-point time was obtained, one line: "per-point time field",
+  /// "reconstructed from azimuth (N scans without a time field)" or "none: N
+  /// scans without a time field read as one instant" (Livox CustomMsg and
+  /// clouds with a time field: "per-point time field").
+  std::string PointTimeSummary() const;
 };
 
 }  // namespace swarmlio::io

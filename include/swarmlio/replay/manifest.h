@@ -7,6 +7,7 @@
 //     - name: uav1
 //       bag: uav1.bag                   # relative to this file's folder
 //       ground_truth: uav1_gt_tum.txt   # optional TUM file (else the bag's topic, if any)
+//       ground_truth_frame: auto        # G | other | auto (default): frame of the ground truth
 //       sensor_preset: ../configs/livox_mid360.yaml   # lidar: + imu: sections
 //       lidar: {p_lidar_in_imu_m: [0, 0, 0.08]}        # optional overrides
 //       bag_topics: {imu_topic: /mavros/imu/data}
@@ -20,7 +21,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "swarmlio/common/status.h"
@@ -33,10 +36,18 @@
 
 namespace swarmlio::replay {
 
+/// Frame of a drone's ground truth (manifest key `ground_truth_frame`).
+///   kAuto:  G when the ground truth at the estimate's first stamp matches the
+///           estimate's first pose (within tolerance), else another frame
+///   kG:     the estimator's G (the IMU frame at the static start), declared
+///   kOther: another frame (mocap, simulator world), declared
+enum class GroundTruthFrame { kAuto, kG, kOther };
+
 struct DroneInput {
   std::string name;
   std::string bag_path;           // resolved (relative to the manifest folder)
   std::string ground_truth_path;  // resolved TUM file, "" = none
+  GroundTruthFrame ground_truth_frame = GroundTruthFrame::kAuto;
   LidarOptions lidar;
   ImuOptions imu;
   io::BagReaderOptions bag;
@@ -72,3 +83,16 @@ Status ManifestFromBags(const std::vector<std::string>& bags, const std::string&
                         const std::vector<std::string>& names, SwarmManifest* manifest);
 
 }  // namespace swarmlio::replay
+
+namespace swarmlio::config {
+
+template <>
+struct EnumTraits<replay::GroundTruthFrame> {
+  static constexpr std::array<std::pair<replay::GroundTruthFrame, const char*>, 3> kNames{{
+      {replay::GroundTruthFrame::kAuto, "auto"},
+      {replay::GroundTruthFrame::kG, "G"},
+      {replay::GroundTruthFrame::kOther, "other"},
+  }};
+};
+
+}  // namespace swarmlio::config

@@ -1,0 +1,139 @@
+// Ground truth in the estimator's G or in another frame (mocap, simulator
+// world): CheckGroundTruthFrame decides, AlignGroundTruthByFirstPose moves it
+// into G, and the manifest key ground_truth_frame overrides the detection.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "swarmlio/math/so3.h"
+#include "swarmlio/replay/consistency.h"
+#include "swarmlio/replay/manifest.h"
+
+namespace swarmlio::replay {
+namespace {
+
+// An estimate along a curve in G (1 cm off the truth), and its ground truth
+// in G, 20 Hz, 5 s.
+void MakeRun(std::vector<ScanRecord>* scans, std::vector<PoseStamped>* truth) {
+  for (int k = 0; k < 100; ++k) {
+    const double t = 0.05 * k;
+    PoseStamped p;
+    p.stamp_ns = 1'000'000'000LL + 50'000'000LL * k;
+    p.p_b_in_G = Eigen::Vector3d(std::sin(t), 0.5 * t, 0.1 * t * t);
+    p.q_G_b = so3::ExpQuaternion(Eigen::Vector3d(0.0, 0.02 * t, 0.3 * t));
+    truth->push_back(p);
+    ScanRecord r;
+    r.stamp_ns = p.stamp_ns;
+    r.updated = true;
+    r.state.p_b_in_G = p.p_b_in_G + Eigen::Vector3d(0.01, 0.0, 0.0);
+    r.state.q_G_b = p.q_G_b;
+    r.pose_covariance = 1e-4 * Eigen::Matrix<double, 6, 6>::Identity();
+    scans->push_back(r);
+  }
+}
+
+std::vector<PoseStamped> InWorld(const std::vector<PoseStamped>& truth) {
+  const Eigen::Quaterniond q_W_G = so3::ExpQuaternion(Eigen::Vector3d(0.1, -0.2, 1.4));
+  const Eigen::Vector3d p_G_in_W(4.0, -2.0, 1.0);
+  std::vector<PoseStamped> out = truth;
+  for (PoseStamped& p : out) {
+    p.p_b_in_G = q_W_G * p.p_b_in_G + p_G_in_W;
+    p.q_G_b = q_W_G * p.q_G_b;
+  }
+  return out;
+}
+
+TEST(FrameCheck, GroundTruthInGIsDetected) {
+  std::vector<ScanRecord> scans;
+  std::vector<PoseStamped> truth;
+  MakeRun(&scans, &truth);
+  FrameCheck check;
+  ASSERT_TRUE(
+      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
+          .ok());
+  EXPECT_TRUE(check.compared);
+  EXPECT_TRUE(check.same_frame);
+  EXPECT_FALSE(check.declared);
+  EXPECT_NEAR(check.position_offset_m, 0.01, 1e-9);
+  EXPECT_NE(check.Summary().find("ground truth in G"), std::string::npos) << check.Summary();
+}
+
+TEST(FrameCheck, ForeignFrameIsDetectedAndAlignedByTheFirstPose) {
+  std::vector<ScanRecord> scans;
+  std::vector<PoseStamped> truth;
+  MakeRun(&scans, &truth);
+  const std::vector<PoseStamped> world = InWorld(truth);
+  FrameCheck check;
+  ASSERT_TRUE(
+      CheckGroundTruthFrame(scans, world, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
+          .ok());
+  EXPECT_FALSE(check.same_frame);
+  EXPECT_GT(check.position_offset_m, 1.0);
+  EXPECT_NE(check.Summary().find("ground truth in another frame: aligned by first pose and SE(3)"),
+            std::string::npos)
+      << check.Summary();
+
+  // Unaligned, the NEES of a foreign frame is huge; aligned by the first pose
+  // the position errors are the estimate's own (1 cm here).
+  ConsistencyStats raw, aligned_stats;
+  ASSERT_TRUE(EvaluateConsistency(scans, world, 0.06, &raw).ok());
+  EXPECT_GT(raw.mean_position_nees, 1e4);
+  std::vector<PoseStamped> aligned;
+  ASSERT_TRUE(AlignGroundTruthByFirstPose(scans, world, check, 0.06, &aligned).ok());
+  ASSERT_TRUE(EvaluateConsistency(scans, aligned, 0.06, &aligned_stats).ok());
+  EXPECT_LT(aligned_stats.position_rmse_m, 0.012);
+
+  // Declared: the manifest wins over the detection.
+  ASSERT_TRUE(
+      CheckGroundTruthFrame(scans, world, GroundTruthFrame::kG, FrameCheckOptions(), &check).ok());
+  EXPECT_TRUE(check.same_frame);
+  EXPECT_TRUE(check.declared);
+  ASSERT_TRUE(
+      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kOther, FrameCheckOptions(), &check)
+          .ok());
+  EXPECT_FALSE(check.same_frame);
+}
+
+TEST(FrameCheck, NoOverlapIsAnError) {
+  std::vector<ScanRecord> scans;
+  std::vector<PoseStamped> truth;
+  MakeRun(&scans, &truth);
+  for (PoseStamped& p : truth) p.stamp_ns += 100'000'000'000LL;
+  FrameCheck check;
+  EXPECT_EQ(
+      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
+          .code(),
+      Status::Code::kFailedPrecondition);
+}
+
+TEST(FrameCheck, ManifestKeyGroundTruthFrame) {
+  SwarmManifest manifest;
+  const Status status = ParseManifest(
+      "name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: G}\n"
+      "  - {name: b, bag: b.bag, ground_truth_frame: other}\n  - {name: c, bag: c.bag}\n",
+      "/tmp/m.yaml", &manifest);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(manifest.drones[0].ground_truth_frame, GroundTruthFrame::kG);
+  EXPECT_EQ(manifest.drones[1].ground_truth_frame, GroundTruthFrame::kOther);
+  EXPECT_EQ(manifest.drones[2].ground_truth_frame, GroundTruthFrame::kAuto);
+  EXPECT_FALSE(ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: W}\n",
+                             "/tmp/m.yaml", &manifest)
+                   .ok());
+}
+
+TEST(FrameCheck, ManifestMarksSpinningLidars) {
+  SwarmManifest manifest;
+  const std::string preset = std::string(SWARMLIO_SOURCE_DIR) + "/configs/spinning_32.yaml";
+  ASSERT_TRUE(ManifestFromBags({"a.bag"}, preset, {}, &manifest).ok());
+  EXPECT_TRUE(manifest.drones[0].bag.spinning_lidar);
+  ASSERT_TRUE(ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, sensor_preset: " + preset +
+                                ", bag_topics: {spinning_lidar: false}}\n",
+                            "/tmp/m.yaml", &manifest)
+                  .ok());
+  EXPECT_FALSE(manifest.drones[0].bag.spinning_lidar);
+}
+
+}  // namespace
+}  // namespace swarmlio::replay
