@@ -177,6 +177,7 @@ struct DroneEstimator::Impl {
   std::vector<teammate::ScanPoint> points;
   teammate::ScanResult detection;
   double last_detection_stamp_s = 0.0;
+  double degenerate_average = 0.0;  // EMA of the own degeneracy flags
   Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();
   // The scan in flight (between OnFrontEnd and OnScanDone).
   SwarmPart part;
@@ -498,7 +499,11 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
   std::set<int> estimated;
   // A well-localized drone does not take a degenerate teammate's pose into
   // its own state; a degenerate one still does (it is its best information).
-  const bool skip_degenerate = so.skip_degenerate_teammates && !scan.previous_scan_degenerate;
+  // Only a drone that is degenerate most of the time (an exponential average
+  // of its flags over ~10 scans above one half), not one with an occasional
+  // flagged scan, relies on degenerate teammates.
+  im.degenerate_average = 0.9 * im.degenerate_average + (scan.previous_scan_degenerate ? 0.1 : 0.0);
+  const bool skip_degenerate = so.skip_degenerate_teammates && im.degenerate_average < 0.5;
   const double gate2 = so.gate_sigma * so.gate_sigma;
   const auto add = [&](std::unique_ptr<ceres::CostFunction> cost, int teammate_id,
                        const Eigen::Vector3d& innovation, const Eigen::Matrix3d& S) {
