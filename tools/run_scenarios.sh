@@ -60,9 +60,13 @@ for name in "${scenarios[@]}"; do
     echo '```'
     echo
     if [[ $status -ne 0 ]]; then echo "Replay exit status $status (see $dir.swarm.log)."; echo; fi
-    echo "Swarm mode (messages through the simulated network; the estimators do not yet use them):"
+    echo "Swarm mode (mutual observations fused; messages through the simulated network):"
     echo
     cat "$dir/swarm/metrics.md" 2>/dev/null || echo "(no table)"
+    echo
+    echo "Teammates (swarm mode; docs/replay.md \"Swarm outputs\"):"
+    echo
+    cat "$dir/swarm/swarm.md" 2>/dev/null || echo "(no table)"
     echo
     echo "Single-agent ablation:"
     echo
