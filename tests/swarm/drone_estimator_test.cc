@@ -205,8 +205,8 @@ class ObserverSink : public sim::DroneSink {
 
 // The first `duration_s` of indoor_3uav for one observer fed by ObserverSink.
 struct ObserverRun {
-  ObserverRun(sim::Scenario scenario, double duration_s, int observer, int teammate)
-      : observer(observer) {
+  ObserverRun(sim::Scenario scenario, double duration_s, int observer_id, int teammate)
+      : observer(observer_id) {
     sim::SimulationConfig config = scenario.simulation_config();
     config.duration_s = duration_s;
     config.num_threads = 1;
