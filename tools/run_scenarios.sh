@@ -66,7 +66,14 @@ for name in "${scenarios[@]}"; do
     echo
     echo "Teammates (swarm mode; docs/replay.md \"Swarm outputs\"):"
     echo
-    cat "$dir/swarm/swarm.md" 2>/dev/null || echo "(no table)"
+    if [[ -f "$dir/swarm/swarm.md" ]]; then
+      # Identified pairs only (swarm_40 has 1560 pairs), and how many were not.
+      grep -v '| never |' "$dir/swarm/swarm.md"
+      echo
+      echo "Pairs never identified: $(grep -c '| never |' "$dir/swarm/swarm.md" || true) of $(($(wc -l < "$dir/swarm/swarm.md") - 2))."
+    else
+      echo "(no table)"
+    fi
     echo
     echo "Single-agent ablation:"
     echo
