@@ -15,121 +15,27 @@
 
 #include "factors/active_observation_factor.h"
 #include "factors/passive_observation_factor.h"
+#include "observation_terms.h"
+#include "teammate_state.h"
 #include "swarmlio/lio/undistortion.h"
 #include "swarmlio/math/so3.h"
 
 namespace swarmlio::swarm {
 namespace {
 
+using internal::FixedExtrinsicCost;
+using internal::Finite;
+using internal::InvertExtrinsic;
+using internal::Mahalanobis2;
+using internal::MutualObservationModel;
+using internal::PendingMutual;
+using internal::PendingPassive;
+using internal::Predict;
+using internal::PredictedTeammate;
+using internal::Regularized;
+using internal::TeammateInfo;
+
 double Seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
-
-// A two-block observation cost (ego, extrinsic) with the extrinsic held
-// constant: the degeneracy policy "freeze extrinsics" (docs/swarm.md).
-class FixedExtrinsicCost final : public ceres::CostFunction {
- public:
-  FixedExtrinsicCost(std::unique_ptr<ceres::CostFunction> inner, const GlobalExtrinsic& T)
-      : inner_(std::move(inner)) {
-    T.ToParameters(extrinsic_.data());
-    set_num_residuals(inner_->num_residuals());
-    mutable_parameter_block_sizes()->push_back(EgoState::kAmbientSize);
-  }
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const double* blocks[2] = {parameters[0], extrinsic_.data()};
-    double* inner_jacobians[2] = {jacobians != nullptr ? jacobians[0] : nullptr, nullptr};
-    return inner_->Evaluate(blocks, residuals, jacobians != nullptr ? inner_jacobians : nullptr);
-  }
-
- private:
-  std::unique_ptr<ceres::CostFunction> inner_;
-  std::array<double, GlobalExtrinsic::kAmbientSize> extrinsic_{};
-};
-
-// The mutual observations of one scan: factors built at the front end; the
-// update re-evaluates them at every iteration (their residuals are exact
-// functions of the state; only the noise is fixed at the prediction).
-class MutualObservationModel final : public MeasurementModel {
- public:
-  const char* name() const override { return "mutual_observation"; }
-  Status Linearize(const SwarmState&, std::vector<ResidualTerm>* terms) override {
-    for (size_t k = 0; k < costs_.size(); ++k) terms->push_back({costs_[k].get(), blocks_[k]});
-    return Status::Ok();
-  }
-  void Clear() {
-    costs_.clear();
-    blocks_.clear();
-  }
-  void Add(std::unique_ptr<ceres::CostFunction> cost, std::vector<int> blocks) {
-    costs_.push_back(std::move(cost));
-    blocks_.push_back(std::move(blocks));
-  }
-  bool empty() const { return costs_.empty(); }
-
- private:
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
-  std::vector<std::vector<int>> blocks_;
-};
-
-bool Finite(const net::EgoStateMessage& m) {
-  return m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite() && m.v_bj_in_Gj.allFinite() &&
-         m.omega_bj_in_bj.allFinite() && m.cov_theta_Gj_bj.allFinite() &&
-         m.cov_p_bj_in_Gj.allFinite() && m.cov_v_bj_in_Gj.allFinite();
-}
-
-// A covariance from the network or the detector, made symmetric positive
-// definite: eigenvalues clamped to at least `floor` ((1 mm)^2 by default).
-// The network checks only finiteness and non-negative variances, so an
-// indefinite matrix from a broken teammate must not reach a factor.
-template <int N>
-Eigen::Matrix<double, N, N> Regularized(const Eigen::Matrix<double, N, N>& C, double floor = 1e-6) {
-  using Matrix = Eigen::Matrix<double, N, N>;
-  const Matrix S = 0.5 * (C + C.transpose());
-  const Eigen::SelfAdjointEigenSolver<Matrix> eig(S);
-  const Eigen::Matrix<double, N, 1> values = eig.eigenvalues().cwiseMax(floor);
-  return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
-}
-
-// Mahalanobis distance^2 of h - z under S.
-double Mahalanobis2(const Eigen::Vector3d& e, const Eigen::Matrix3d& S) {
-  return e.dot(S.ldlt().solve(e));
-}
-
-struct TeammateInfo {
-  bool have_message = false;
-  net::EgoStateMessage last;       // the newest received state
-  int64_t session_start_ns = 0;
-  int64_t last_heard_ns = 0;       // arrival of the newest message (own clock)
-  int64_t last_seen_ns = 0;        // last LiDAR observation (own clock)
-  bool restarted = false;          // session_start changed: drop its block
-};
-
-// A teammate's broadcast state predicted to time t (own clock).
-struct PredictedTeammate {
-  Eigen::Matrix3d R_Gj_bj;
-  Eigen::Vector3d p_bj_in_Gj;
-  Eigen::Vector3d v_bj_in_Gj;
-  Eigen::Matrix3d cov_p;
-  Eigen::Matrix3d cov_theta;
-};
-
-PredictedTeammate Predict(const net::EgoStateMessage& m, double dt) {
-  PredictedTeammate out;
-  const Eigen::Matrix3d R = m.q_Gj_bj.normalized().toRotationMatrix();
-  out.R_Gj_bj = R * so3::Exp(m.omega_bj_in_bj * dt);
-  out.p_bj_in_Gj = m.p_bj_in_Gj + m.v_bj_in_Gj * dt;
-  out.v_bj_in_Gj = m.v_bj_in_Gj;
-  out.cov_p = m.cov_p_bj_in_Gj + dt * dt * m.cov_v_bj_in_Gj;
-  out.cov_theta = m.cov_theta_Gj_bj;
-  return out;
-}
-
-struct PendingPassive {
-  int from = -1;
-  int64_t stamp_ns = 0;  // when j saw this drone (j's scan end, assumed own clock)
-  Eigen::Vector3d p_bi_in_bj = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
-  net::EgoStateMessage sender;  // j's state at that time
-};
 
 // What OnScanDone records, joined with the odometry's output afterwards.
 struct SwarmPart {
@@ -145,25 +51,6 @@ struct SwarmPart {
 };
 
 }  // namespace
-
-// A teammate's T_Gj_Gi (it identified this drone), waiting for the next scan.
-struct PendingMutual {
-  net::GlobalExtrinsicEntry entry;  // entry.teammate_id == this drone
-};
-
-// T_Gi_Gj = T_Gj_Gi^-1 with the covariance mapped to the inverse's error
-// state (R Exp(theta), p + dp): theta' = -R theta, dp' = [p']x theta - R^T dp.
-void InvertExtrinsic(const net::GlobalExtrinsicEntry& e, GlobalExtrinsic* T,
-                     Eigen::Matrix<double, 6, 6>* C) {
-  const Eigen::Matrix3d R = e.q_Gi_Gj.normalized().toRotationMatrix();
-  T->q_Gi_Gj = e.q_Gi_Gj.normalized().conjugate();
-  T->p_Gj_in_Gi = -(R.transpose() * e.p_Gj_in_Gi);
-  Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
-  J.topLeftCorner<3, 3>() = -R;
-  J.bottomLeftCorner<3, 3>() = so3::Hat(T->p_Gj_in_Gi);
-  J.bottomRightCorner<3, 3>() = -R.transpose();
-  *C = J * e.covariance * J.transpose();
-}
 
 struct DroneEstimator::Impl {
   std::map<int, TeammateInfo> teammates;

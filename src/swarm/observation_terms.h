@@ -1,0 +1,87 @@
+// The mutual-observation residual terms of one scan (swarm::DroneEstimator,
+// docs/swarm.md section 4): the model the update re-evaluates at every
+// iteration, the constant-extrinsic wrapper of the degeneracy policy, and the
+// covariance hygiene every input from the network goes through. Internal to
+// src/swarm.
+#pragma once
+
+#include <ceres/cost_function.h>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <array>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "swarmlio/lio/measurement_model.h"
+#include "swarmlio/state/swarm_state.h"
+
+namespace swarmlio::swarm::internal {
+
+// A two-block observation cost (ego, extrinsic) with the extrinsic held
+// constant: the degeneracy policy "freeze extrinsics" (docs/swarm.md).
+class FixedExtrinsicCost final : public ceres::CostFunction {
+ public:
+  FixedExtrinsicCost(std::unique_ptr<ceres::CostFunction> inner, const GlobalExtrinsic& T)
+      : inner_(std::move(inner)) {
+    T.ToParameters(extrinsic_.data());
+    set_num_residuals(inner_->num_residuals());
+    mutable_parameter_block_sizes()->push_back(EgoState::kAmbientSize);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* blocks[2] = {parameters[0], extrinsic_.data()};
+    double* inner_jacobians[2] = {jacobians != nullptr ? jacobians[0] : nullptr, nullptr};
+    return inner_->Evaluate(blocks, residuals, jacobians != nullptr ? inner_jacobians : nullptr);
+  }
+
+ private:
+  std::unique_ptr<ceres::CostFunction> inner_;
+  std::array<double, GlobalExtrinsic::kAmbientSize> extrinsic_{};
+};
+
+// The mutual observations of one scan: factors built at the front end; the
+// update re-evaluates them at every iteration (their residuals are exact
+// functions of the state; only the noise is fixed at the prediction).
+class MutualObservationModel final : public MeasurementModel {
+ public:
+  const char* name() const override { return "mutual_observation"; }
+  Status Linearize(const SwarmState&, std::vector<ResidualTerm>* terms) override {
+    for (size_t k = 0; k < costs_.size(); ++k) terms->push_back({costs_[k].get(), blocks_[k]});
+    return Status::Ok();
+  }
+  void Clear() {
+    costs_.clear();
+    blocks_.clear();
+  }
+  void Add(std::unique_ptr<ceres::CostFunction> cost, std::vector<int> blocks) {
+    costs_.push_back(std::move(cost));
+    blocks_.push_back(std::move(blocks));
+  }
+  bool empty() const { return costs_.empty(); }
+
+ private:
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
+  std::vector<std::vector<int>> blocks_;
+};
+
+// A covariance from the network or the detector, made symmetric positive
+// definite: eigenvalues clamped to at least `floor` ((1 mm)^2 by default).
+// The network checks only finiteness and non-negative variances, so an
+// indefinite matrix from a broken teammate must not reach a factor.
+template <int N>
+Eigen::Matrix<double, N, N> Regularized(const Eigen::Matrix<double, N, N>& C, double floor = 1e-6) {
+  using Matrix = Eigen::Matrix<double, N, N>;
+  const Matrix S = 0.5 * (C + C.transpose());
+  const Eigen::SelfAdjointEigenSolver<Matrix> eig(S);
+  const Eigen::Matrix<double, N, 1> values = eig.eigenvalues().cwiseMax(floor);
+  return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+// Mahalanobis distance^2 of h - z under S.
+double Mahalanobis2(const Eigen::Vector3d& e, const Eigen::Matrix3d& S) {
+  return e.dot(S.ldlt().solve(e));
+}
+
+}  // namespace swarmlio::swarm::internal

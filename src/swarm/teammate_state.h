@@ -1,0 +1,59 @@
+// What one drone knows of each teammate from its messages (swarm::
+// DroneEstimator, docs/swarm.md): the newest broadcast state and its session,
+// when it was last heard and seen, the passive observations and the mutual
+// identification waiting for the next scan, and the few operations on them.
+// Internal to src/swarm.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "swarmlio/net/messages.h"
+#include "swarmlio/state/swarm_state.h"
+
+namespace swarmlio::swarm::internal {
+
+/// The message is finite in every field the estimator uses.
+bool Finite(const net::EgoStateMessage& m);
+
+struct TeammateInfo {
+  bool have_message = false;
+  net::EgoStateMessage last;       // the newest received state
+  int64_t session_start_ns = 0;
+  int64_t last_heard_ns = 0;       // arrival of the newest message (own clock)
+  int64_t last_seen_ns = 0;        // last LiDAR observation (own clock)
+  bool restarted = false;          // session_start changed: drop its block
+};
+
+// A teammate's broadcast state predicted to time t (own clock).
+struct PredictedTeammate {
+  Eigen::Matrix3d R_Gj_bj;
+  Eigen::Vector3d p_bj_in_Gj;
+  Eigen::Vector3d v_bj_in_Gj;
+  Eigen::Matrix3d cov_p;
+  Eigen::Matrix3d cov_theta;
+};
+
+/// j's broadcast state moved by dt [s] with its velocity and angular rate
+/// (covariance: position + dt^2 velocity).
+PredictedTeammate Predict(const net::EgoStateMessage& m, double dt);
+
+struct PendingPassive {
+  int from = -1;
+  int64_t stamp_ns = 0;  // when j saw this drone (j's scan end, assumed own clock)
+  Eigen::Vector3d p_bi_in_bj = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
+  net::EgoStateMessage sender;  // j's state at that time
+};
+
+// A teammate's T_Gj_Gi (it identified this drone), waiting for the next scan.
+struct PendingMutual {
+  net::GlobalExtrinsicEntry entry;  // entry.teammate_id == this drone
+};
+
+// T_Gi_Gj = T_Gj_Gi^-1 with the covariance mapped to the inverse's error
+// state (R Exp(theta), p + dp): theta' = -R theta, dp' = [p']x theta - R^T dp.
+void InvertExtrinsic(const net::GlobalExtrinsicEntry& e, GlobalExtrinsic* T,
+                     Eigen::Matrix<double, 6, 6>* C);
+
+}  // namespace swarmlio::swarm::internal
