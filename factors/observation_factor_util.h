@@ -6,6 +6,7 @@
 //     that |L^-1 e|^2 = e^T S^-1 e; CHECKs that S is positive definite (the
 //     caller, swarm::DroneEstimator, regularizes every covariance it is
 //     handed, so a failure here is a programming error).
+//   Evaluate is the Ceres Evaluate of both factors.
 //   WriteObservationJacobians lifts the tangent Jacobians (3x18 ego, 3x6
 //     extrinsic, ErrorStateLayout order) to Ceres's ambient blocks: the
 //     rotation columns through SO3Manifold::LiftTangentJacobian, the
@@ -47,6 +48,24 @@ inline void WriteObservationJacobians(const EgoTangentJacobian& J_ego,
     J.leftCols<4>() = SO3Manifold::LiftTangentJacobian<3>(J_ext.leftCols<3>(), parameters[1]);
     J.rightCols<3>() = J_ext.rightCols<3>();
   }
+}
+
+/// The Ceres Evaluate of either factor: residual from its Residual(), and
+/// both tangent Jacobians (a few flops) from its TangentJacobian(), lifted
+/// into the requested ambient blocks.
+template <class Factor>
+bool Evaluate(const Factor& factor, double const* const* parameters, double* residuals,
+              double** jacobians) {
+  const EgoState ego = EgoState::FromParameters(parameters[0]);
+  const GlobalExtrinsic extrinsic = GlobalExtrinsic::FromParameters(parameters[1]);
+  Eigen::Map<Eigen::Vector3d> r(residuals);
+  r = factor.Residual(ego, extrinsic);
+  if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) return true;
+  EgoTangentJacobian J_ego;
+  ExtrinsicTangentJacobian J_ext;
+  factor.TangentJacobian(ego, extrinsic, &J_ego, &J_ext);
+  WriteObservationJacobians(J_ego, J_ext, parameters, jacobians);
+  return true;
 }
 
 }  // namespace swarmlio::observation_factor

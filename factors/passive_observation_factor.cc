@@ -67,19 +67,7 @@ void PassiveObservationFactor::TangentJacobian(
 bool PassiveObservationFactor::Evaluate(double const* const* parameters,
                                         double* residuals,
                                         double** jacobians) const {
-  const EgoState ego = EgoState::FromParameters(parameters[0]);
-  const GlobalExtrinsic extrinsic = GlobalExtrinsic::FromParameters(parameters[1]);
-  Eigen::Map<Eigen::Vector3d> r(residuals);
-  r = Residual(ego, extrinsic);
-  if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) return true;
-
-  // Both tangent Jacobians are computed (a few flops); only the requested
-  // ambient blocks are written.
-  observation_factor::EgoTangentJacobian J_ego;
-  observation_factor::ExtrinsicTangentJacobian J_ext;
-  TangentJacobian(ego, extrinsic, &J_ego, &J_ext);
-  observation_factor::WriteObservationJacobians(J_ego, J_ext, parameters, jacobians);
-  return true;
+  return observation_factor::Evaluate(*this, parameters, residuals, jacobians);
 }
 
 }  // namespace swarmlio

@@ -129,7 +129,6 @@ Status PlaneMeasurementModel::Linearize(const SwarmState& x, std::vector<Residua
   if (!associate_) return Status::InvalidArgument("no association callback");
   correspondences_.clear();
   SWARMLIO_RETURN_IF_ERROR(associate_(x, &correspondences_));
-  factor_.SyncNumResiduals();
   if (correspondences_.empty()) return Status::Ok();
   // The N point rows enter Ceres as their 6-row information form at x
   // (PoseInformationFactor): the same Gauss-Newton step, a 6-row instead of
