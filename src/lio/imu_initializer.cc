@@ -285,8 +285,11 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   r.sign_warning = sign_warning;
 
   // 5. Covariance (docs/imu.md): pose/velocity floors, standard error of the
-  // gyro mean, the b_a prior, and gravity = -b_a + noise of the acc mean
-  // (a_m = -R^T g + b_a at rest, R = I), hence Cov(g, b_a) = -Cov(b_a).
+  // gyro mean, the b_a prior, and the gravity error. At rest (R = I)
+  // a_m = -g + b_a, so g_hat = -mean(a_m) with b_a_hat = 0 has the error
+  // g_hat - g = -b_a = b_a_hat - b_a: the errors of g and b_a are EQUAL (up to
+  // the noise of the mean), hence Cov(g, b_a) = +Cov(b_a) and only their
+  // difference, which the accelerometer measured, is known tightly.
   auto& P = r.covariance;
   P.setZero();
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
@@ -303,8 +306,8 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   P.block<3, 3>(L::kAccelBias.offset, L::kAccelBias.offset) = sba * sba * I;
   P.block<3, 3>(L::kGravity.offset, L::kGravity.offset) =
       sba * sba * I + unit_factor * unit_factor * stats.cov_accel / n + sg * sg * I;
-  P.block<3, 3>(L::kGravity.offset, L::kAccelBias.offset) = -sba * sba * I;
-  P.block<3, 3>(L::kAccelBias.offset, L::kGravity.offset) = -sba * sba * I;
+  P.block<3, 3>(L::kGravity.offset, L::kAccelBias.offset) = sba * sba * I;
+  P.block<3, 3>(L::kAccelBias.offset, L::kGravity.offset) = sba * sba * I;
   return Status::Ok();
 }
 

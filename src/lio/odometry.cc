@@ -54,6 +54,7 @@ struct Odometry::Impl {
   EsikfUpdate update;
   std::deque<ImuSample> imu_queue;  // after initialization, not yet propagated
   std::deque<PendingScan> scan_queue;
+  std::deque<PendingScan> static_start_scans;  // before initialization (map seeding)
   std::vector<ScanOutput> outputs;
   int64_t last_imu_stamp_ns = 0;
   bool have_imu = false;
@@ -136,6 +137,7 @@ Status Odometry::AddImu(const ImuSample& raw) {
     impl_->initialization = init;
     impl_->initialized = true;
     init_error_.clear();
+    SeedMapFromStaticStart(impl_->initializer->window_start_ns());
     return Status::Ok();
   }
   impl_->imu_queue.push_back(sample);
@@ -149,11 +151,19 @@ Status Odometry::AddScan(const LidarScan& scan) {
     return Status::InvalidArgument("scan at " + std::to_string(scan.stamp_ns) +
                                    " ns has no points; dropped");
   }
+  const int64_t end_ns = ScanEndNs(scan);
   if (!impl_->initialized || scan.stamp_ns < impl_->initialization.stamp_ns) {
     ++counters_.scans_before_init;
+    if (!impl_->initialized && options_.seed_map_from_static_start) {
+      // Kept while it may still lie in the initialization window.
+      auto& kept = impl_->static_start_scans;
+      kept.push_back({scan, end_ns});
+      const int64_t window_start_ns = impl_->initializer->window_start_ns();
+      while (!kept.empty() && kept.front().scan.stamp_ns < window_start_ns) kept.pop_front();
+      while (static_cast<int>(kept.size()) > options_.max_queued_scans) kept.pop_front();
+    }
     return Status::Ok();  // expected during the static start: not an error
   }
-  const int64_t end_ns = ScanEndNs(scan);
   const int64_t previous_end_ns = impl_->scan_queue.empty() ? impl_->last_scan_end_ns
                                                             : impl_->scan_queue.back().end_ns;
   if ((impl_->have_scan || !impl_->scan_queue.empty()) && end_ns <= previous_end_ns) {
@@ -172,6 +182,27 @@ Status Odometry::AddScan(const LidarScan& scan) {
   }
   const Status processed = ProcessReadyScans(/*flush=*/false);
   return status.ok() ? processed : status;
+}
+
+void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
+  Impl& im = *impl_;
+  // The window passed the static test, so a scan wholly inside it was taken
+  // at the initial pose: R_G_b = I, p_b_in_G = 0 (G is the IMU frame at the
+  // window's end), without motion distortion.
+  std::vector<Eigen::Vector3d> points_in_G;
+  for (const PendingScan& pending : im.static_start_scans) {
+    if (pending.scan.stamp_ns < window_start_ns || pending.end_ns > im.initialization.stamp_ns) {
+      continue;
+    }
+    im.preprocess->Run(pending.scan, &im.points_in_b);
+    if (static_cast<int>(im.points_in_b.size()) < options_.min_scan_points) continue;
+    for (const PointXYZT& p : im.points_in_b) points_in_G.push_back(p.p_in_b);
+    ++counters_.scans_seeding_map;
+  }
+  im.static_start_scans.clear();
+  if (points_in_G.empty()) return;
+  im.map.UpdateCenter(Eigen::Vector3d::Zero());
+  im.map.Insert(points_in_G);
 }
 
 Status Odometry::Flush() { return ProcessReadyScans(/*flush=*/true); }

@@ -28,6 +28,8 @@ Status DecodeEntry(WireReader* r, GlobalExtrinsicEntry* e) {
 
 void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& m, WireWriter* w) {
   w->I64(m.stamp_ns);
+  WriteVectorF32(m.g_in_Gi, w);
+  WriteUpperTriangleF32<3>(m.cov_g_in_Gi, w);
   w->U8(static_cast<uint8_t>(m.entries.size()));
   for (const GlobalExtrinsicEntry& e : m.entries) {
     w->U8(static_cast<uint8_t>(e.teammate_id));
@@ -42,6 +44,8 @@ Status DecodeGlobalExtrinsic(int sender_id, WireReader* r, GlobalExtrinsicMessag
   GlobalExtrinsicMessage m;
   m.sender_id = sender_id;
   SWARMLIO_RETURN_IF_ERROR(r->I64("stamp_ns", &m.stamp_ns));
+  SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("g_in_Gi", r, &m.g_in_Gi));
+  SWARMLIO_RETURN_IF_ERROR(ReadUpperTriangleF32<3>("cov_g_in_Gi", r, &m.cov_g_in_Gi));
   uint8_t count = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("entry count", &count));
   if (count > GlobalExtrinsicMessage::kMaxEntries) {

@@ -134,6 +134,8 @@ Status Check(const GlobalExtrinsicMessage& m) {
   Checker c("GlobalExtrinsic");
   c.Id("sender_id", m.sender_id);
   c.Stamp("stamp_ns", m.stamp_ns);
+  c.Vector32("g_in_Gi", m.g_in_Gi);
+  c.Covariance<3>("cov_g_in_Gi", m.cov_g_in_Gi);
   if (m.entries.size() > static_cast<size_t>(GlobalExtrinsicMessage::kMaxEntries)) {
     c.Fail("entries", -1,
            "has " + std::to_string(m.entries.size()) + " entries, more than the maximum " +

@@ -37,7 +37,8 @@ int SenderOf(const SwarmMessage& message) {
 }
 
 std::vector<GlobalExtrinsicMessage> SplitGlobalExtrinsics(
-    int sender_id, int64_t stamp_ns, const std::vector<GlobalExtrinsicEntry>& entries) {
+    int sender_id, int64_t stamp_ns, const std::vector<GlobalExtrinsicEntry>& entries,
+    const Eigen::Vector3d& g_in_Gi, const Eigen::Matrix3d& cov_g_in_Gi) {
   std::vector<GlobalExtrinsicMessage> messages;
   size_t begin = 0;
   do {
@@ -46,6 +47,8 @@ std::vector<GlobalExtrinsicMessage> SplitGlobalExtrinsics(
     GlobalExtrinsicMessage m;
     m.sender_id = sender_id;
     m.stamp_ns = stamp_ns;
+    m.g_in_Gi = g_in_Gi;
+    m.cov_g_in_Gi = cov_g_in_Gi;
     m.entries.assign(entries.begin() + static_cast<std::ptrdiff_t>(begin),
                      entries.begin() + static_cast<std::ptrdiff_t>(end));
     messages.push_back(std::move(m));

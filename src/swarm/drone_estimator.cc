@@ -14,6 +14,7 @@
 #include <variant>
 
 #include "factors/active_observation_factor.h"
+#include "factors/gravity_alignment_factor.h"
 #include "factors/passive_observation_factor.h"
 #include "observation_terms.h"
 #include "teammate_state.h"
@@ -44,6 +45,7 @@ struct SwarmPart {
   std::vector<int> removed;
   int active = 0;
   int passive = 0;
+  int gravity = 0;
   int rejected = 0;
   int skipped_degenerate = 0;
   bool frozen = false;
@@ -120,6 +122,7 @@ void Collect(lio::Odometry* odometry, std::vector<lio::ScanOutput>* scratch,
       d.removed_teammates = std::move(p.removed);
       d.active_observations = p.active;
       d.passive_observations = p.passive;
+      d.gravity_alignments = p.gravity;
       d.rejected_observations = p.rejected;
       d.extrinsics_frozen = p.frozen;
       d.num_detector_points = p.detector_points;
@@ -174,6 +177,13 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
         continue;
       }
       impl_->mutual[g->sender_id] = PendingMutual{e};
+    }
+    // A zero vector: an old sender without gravity; ignored.
+    if (g->g_in_Gi.allFinite() && g->cov_g_in_Gi.allFinite() && g->g_in_Gi.norm() > 1.0) {
+      TeammateInfo& info = impl_->teammates[g->sender_id];
+      info.gravity_pending = true;
+      info.g_in_Gj = g->g_in_Gi;
+      info.cov_g_in_Gj = g->cov_g_in_Gi;
     }
     return Status::Ok();
   }
@@ -470,6 +480,25 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
     }
   }
   im.passive.clear();  // each passive observation is used in one update at most
+  // Gravity alignment: once per received broadcast, not while frozen (it
+  // would then only move the own gravity).
+  if (so.fuse_gravity && fusion_enabled_ && !frozen) {
+    for (int id : x->layout().teammate_ids()) {
+      TeammateInfo& info = im.teammates[id];
+      if (!info.gravity_pending) continue;
+      info.gravity_pending = false;
+      const GlobalExtrinsic& T = x->teammate(id);
+      auto factor = std::make_unique<GravityAlignmentFactor>(
+          info.g_in_Gj, Regularized<3>(info.cov_g_in_Gj, 1e-12), so.gravity_alignment_sigma_m_s2,
+          T.R_Gi_Gj());
+      const Eigen::Vector3d e = factor->Predict(x->ego, T);
+      const Eigen::Matrix3d S = factor->covariance();
+      if (add(std::move(factor), id, e, S)) {
+        ++im.part.gravity;
+        ++counters_.gravity_fused;
+      }
+    }
+  }
 
   if (!im.model.empty()) request->models.push_back(&im.model);
   request->estimated_teammates.assign(estimated.begin(), estimated.end());
@@ -563,8 +592,16 @@ void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState&
         entries.push_back(e);
       }
     }
-    for (net::GlobalExtrinsicMessage& g : net::SplitGlobalExtrinsics(self_id_, t_k, entries)) {
-      im.messages.push_back(std::move(g));
+    const Segment gravity = ErrorStateLayout::kGravity;
+    Eigen::Matrix3d cov_g = P.block<3, 3>(gravity.offset, gravity.offset);
+    cov_g = 0.5 * (cov_g + cov_g.transpose()).eval();
+    const Eigen::Vector3d g = x.ego.g_in_G.allFinite() && cov_g.allFinite()
+                                  ? x.ego.g_in_G
+                                  : Eigen::Vector3d::Zero();
+    if (!cov_g.allFinite()) cov_g.setZero();
+    for (net::GlobalExtrinsicMessage& g_msg :
+         net::SplitGlobalExtrinsics(self_id_, t_k, entries, g, cov_g)) {
+      im.messages.push_back(std::move(g_msg));
     }
     im.last_extrinsic_broadcast_ns = t_k;
     im.broadcast_extrinsics_once = true;

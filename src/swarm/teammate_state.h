@@ -23,6 +23,10 @@ struct TeammateInfo {
   int64_t last_heard_ns = 0;       // arrival of the newest message (own clock)
   int64_t last_seen_ns = 0;        // last LiDAR observation (own clock)
   bool restarted = false;          // session_start changed: drop its block
+  // j's gravity in G_j from its newest GlobalExtrinsic message, fused once.
+  bool gravity_pending = false;
+  Eigen::Vector3d g_in_Gj = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov_g_in_Gj = Eigen::Matrix3d::Zero();
 };
 
 // A teammate's broadcast state predicted to time t (own clock).

@@ -79,13 +79,25 @@ TEST(ImuInitializer, EstimatesGyroBiasAndGravityFromAStaticStart) {
   EXPECT_NEAR(r.accel_stddev_m_s2, std::sqrt(3.0) * imu.accel_noise, 0.2 * imu.accel_noise);
   EXPECT_NE(r.Summary().find("m_s2 (detected)"), std::string::npos) << r.Summary();
 
-  // Covariance: symmetric positive definite; gravity anti-correlated with b_a.
+  // Covariance: symmetric positive definite; the errors of gravity and b_a are
+  // equal (g_hat - g = b_a_hat - b_a at a static start), so the accelerometer
+  // fixes only their difference: Var(dg - db_a) is the noise of the mean and
+  // the floor, Var(dg + db_a) carries the b_a prior.
   const auto& P = r.covariance;
   EXPECT_EQ((P - P.transpose()).norm(), 0.0);
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(P).eigenvalues().minCoeff(), 0.0);
   const double sba2 = std::pow(ImuInitializerOptions().initial_accel_bias_stddev_m_s2, 2);
-  EXPECT_EQ(P(L::kGravity.offset, L::kAccelBias.offset), -sba2);
+  EXPECT_EQ(P(L::kGravity.offset, L::kAccelBias.offset), sba2);
   EXPECT_GT(P(L::kGravity.offset, L::kGravity.offset), sba2);
+  Eigen::VectorXd difference = Eigen::VectorXd::Zero(P.rows());
+  difference(L::kGravity.offset) = 1.0;
+  difference(L::kAccelBias.offset) = -1.0;
+  const double var_difference = difference.dot(P * difference);
+  const double floor2 = std::pow(ImuInitializerOptions().gravity_stddev_floor_m_s2, 2);
+  EXPECT_LT(var_difference, floor2 + 10.0 * imu.accel_noise * imu.accel_noise / 200.0);
+  Eigen::VectorXd sum = difference;
+  sum(L::kAccelBias.offset) = 1.0;
+  EXPECT_GT(sum.dot(P * sum), 3.9 * sba2);
 }
 
 TEST(ImuInitializer, DetectsGUnits) {

@@ -120,9 +120,11 @@ TEST(PacketCodecRobustness, HeaderChecks) {
   p[0] = 'X';
   ExpectRejected(p, "bad magic");
   p = good;
-  p[2] = 2;
+  p[2] = kProtocolVersion + 1;
   EXPECT_EQ(Decode(p).code(), Status::Code::kInvalidArgument);
-  ExpectRejected(p, "unsupported protocol version 2");
+  ExpectRejected(p, "unsupported protocol version " + std::to_string(kProtocolVersion + 1));
+  p[2] = 1;  // version 1: GlobalExtrinsic without gravity
+  ExpectRejected(p, "unsupported protocol version 1");
   p = good;
   p[3] = 9;
   ExpectRejected(p, "unknown message type 9");
@@ -228,13 +230,13 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
   const std::vector<uint8_t> ext = Encode(MakeGlobalExtrinsic(0, 1, 3));
   {  // unknown extrinsic source
     std::vector<uint8_t> p = ext;
-    p[kHeaderBytes + 9 + 1] = 3;
+    p[kHeaderBytes + 45 + 1] = 3;  // stamp, gravity (36 B), count, id
     Resign(&p);
     ExpectRejected(p, "source': unknown value 3");
   }
   {  // entry count above the cap
     std::vector<uint8_t> p = ext;
-    p[kHeaderBytes + 8] = GlobalExtrinsicMessage::kMaxEntries + 1;
+    p[kHeaderBytes + 44] = GlobalExtrinsicMessage::kMaxEntries + 1;
     Resign(&p);
     ExpectRejected(p, "exceeds the maximum");
   }

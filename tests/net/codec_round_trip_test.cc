@@ -60,8 +60,8 @@ TEST(PacketCodec, DocumentedSizes) {
   EXPECT_EQ(EgoStatePacketBytes(1), 235u);
   EXPECT_EQ(EgoStatePacketBytes(4), 346u);
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 1086u);
-  EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 179u);
-  EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 1061u);
+  EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 215u);
+  EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 1097u);
   EXPECT_EQ(TimeSyncPacketBytes(), 70u);
 }
 
@@ -71,7 +71,7 @@ TEST(PacketCodec, HeaderIsLittleEndianAndPacked) {
   ASSERT_TRUE(codec.Encode(MakeTimeSync(5, 9, false), 0x04030201u, &packet).ok());
   const std::vector<uint8_t> header(packet.begin(), packet.begin() + kHeaderBytes);
   const std::vector<uint8_t> expected = {
-      'S', 'L', 1, 3, 5, 0, 0x01, 0x02, 0x03, 0x04, static_cast<uint8_t>(kTimeSyncBytes), 0};
+      'S', 'L', kProtocolVersion, 3, 5, 0, 0x01, 0x02, 0x03, 0x04, static_cast<uint8_t>(kTimeSyncBytes), 0};
   EXPECT_EQ(header, expected);
   // Payload: target, kind, then t1 little endian.
   EXPECT_EQ(packet[12], 9);

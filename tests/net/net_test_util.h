@@ -94,6 +94,8 @@ inline GlobalExtrinsicMessage MakeGlobalExtrinsic(int sender, int num_entries, u
   GlobalExtrinsicMessage m;
   m.sender_id = sender;
   m.stamp_ns = 42'000'000'000 + static_cast<int64_t>(seed);
+  m.g_in_Gi = v.Vector32(9.81);
+  m.cov_g_in_Gi = v.Covariance<3>(1e-4);
   for (int i = 0, id = 0; i < num_entries; ++id) {
     if (id == sender) continue;
     GlobalExtrinsicEntry e;
@@ -145,6 +147,8 @@ inline void ExpectSameMessage(const SwarmMessage& expected, const SwarmMessage& 
     const auto& a = std::get<GlobalExtrinsicMessage>(actual);
     EXPECT_EQ(g->sender_id, a.sender_id);
     EXPECT_EQ(g->stamp_ns, a.stamp_ns);
+    EXPECT_EQ(g->g_in_Gi, a.g_in_Gi);
+    EXPECT_EQ(g->cov_g_in_Gi, a.cov_g_in_Gi);
     ASSERT_EQ(g->entries.size(), a.entries.size());
     for (size_t i = 0; i < g->entries.size(); ++i) {
       EXPECT_EQ(g->entries[i].teammate_id, a.entries[i].teammate_id);

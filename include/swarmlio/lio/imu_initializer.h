@@ -13,7 +13,8 @@
 //     is measured, not assumed;
 //   - accelerometer bias b_a = 0: it is not observable at a static start (it
 //     is indistinguishable from a tilt of gravity), so it gets a prior
-//     covariance and gravity gets the exactly anti-correlated uncertainty.
+//     covariance and gravity the same uncertainty, fully correlated with it
+//     (their errors are equal: only g - b_a was measured).
 // It refuses (FailedPrecondition, with the measured standard deviations and
 // the thresholds) a window that is not static, and rejects NaN samples
 // (InvalidArgument).
@@ -218,6 +219,8 @@ class ImuInitializer {
   void Reset() { window_.clear(); }
 
   int num_samples_in_window() const { return static_cast<int>(window_.size()); }
+  /// Stamp of the oldest sample in the window (0 when empty) [ns].
+  int64_t window_start_ns() const { return window_.empty() ? 0 : window_.front().stamp_ns; }
   int num_rejected_non_finite() const { return num_rejected_non_finite_; }
   int num_skipped_out_of_order() const { return num_skipped_out_of_order_; }
 

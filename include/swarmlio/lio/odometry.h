@@ -80,7 +80,8 @@ struct OdometryCounters {
   int64_t imu_out_of_order = 0;      // stamp not after the previous one (dropped)
   int64_t imu_gaps = 0;              // intervals > propagation.max_gap_s (state held)
   int64_t scans = 0;
-  int64_t scans_before_init = 0;     // dropped: IMU not initialized yet
+  int64_t scans_before_init = 0;     // not tracked: IMU not initialized yet
+  int64_t scans_seeding_map = 0;     // of those: inserted at the initial pose (static start)
   int64_t scans_out_of_order = 0;    // dropped: started before the previous scan ended
   int64_t scans_empty = 0;           // dropped: no points
   int64_t scans_dropped_queue = 0;   // dropped: waited too long for IMU data
@@ -142,6 +143,7 @@ class Odometry {
   Odometry(const OdometryOptions& options, const LidarOptions& lidar);
 
   Status ProcessReadyScans(bool flush);
+  void SeedMapFromStaticStart(int64_t window_start_ns);
   Status ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush);
 
   OdometryOptions options_;

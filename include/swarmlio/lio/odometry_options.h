@@ -34,6 +34,12 @@ struct OdometryOptions {
   int max_queued_scans = 20;
   /// Keep the registered (posterior, G frame) downsampled scan in each output.
   bool output_registered_scan = false;
+  /// Seed the map with the scans that lie wholly inside the static IMU
+  /// initialization window, at the initial pose (the window's static test
+  /// shows the drone did not move). A narrow-FoV LiDAR's first scan alone is
+  /// a sparse map whose plane fits tilt the first registrations (0.2 deg on
+  /// the simulated Avia); the window's scans make it dense at no risk.
+  bool seed_map_from_static_start = true;
 
   template <class V>
   void VisitFields(V&& v) {
@@ -52,6 +58,9 @@ struct OdometryOptions {
       FieldSpec::InRange(1.0, 1000.0, "", "scans waiting for IMU data before the oldest is dropped"));
     v("output_registered_scan", output_registered_scan,
       FieldSpec::Doc("keep the registered scan (G frame) in each per-scan output"));
+    v("seed_map_from_static_start", seed_map_from_static_start,
+      FieldSpec::Doc("insert the scans inside the static IMU-initialization window into the map "
+                     "at the initial pose"));
   }
 
   /// "" when valid, else "key: reason".

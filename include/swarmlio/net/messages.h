@@ -82,6 +82,11 @@ struct GlobalExtrinsicMessage {
 
   int sender_id = 0;                          // i
   int64_t stamp_ns = 0;                       // i's clock [ns]
+  /// i's gravity estimate in its own global frame and its covariance: with
+  /// the receiver's, it fixes the tilt of T_Gi_Gj (docs/swarm.md, "Gravity
+  /// alignment"). Sent in every split message.
+  Eigen::Vector3d g_in_Gi = Eigen::Vector3d::Zero();          // [m/s^2]
+  Eigen::Matrix3d cov_g_in_Gi = Eigen::Matrix3d::Zero();      // [m^2/s^4]
   std::vector<GlobalExtrinsicEntry> entries;  // distinct ids, none == sender_id
 };
 
@@ -106,6 +111,8 @@ int SenderOf(const SwarmMessage& message);
 /// Splits `entries` into messages of at most kMaxEntries entries each (at
 /// least one message, possibly empty), all with the same sender and stamp.
 std::vector<GlobalExtrinsicMessage> SplitGlobalExtrinsics(
-    int sender_id, int64_t stamp_ns, const std::vector<GlobalExtrinsicEntry>& entries);
+    int sender_id, int64_t stamp_ns, const std::vector<GlobalExtrinsicEntry>& entries,
+    const Eigen::Vector3d& g_in_Gi = Eigen::Vector3d::Zero(),
+    const Eigen::Matrix3d& cov_g_in_Gi = Eigen::Matrix3d::Zero());
 
 }  // namespace swarmlio::net

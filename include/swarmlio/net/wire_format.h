@@ -1,4 +1,4 @@
-// The swarm packet wire format, version 1 (docs/network.md, "Wire format").
+// The swarm packet wire format, version 2 (docs/network.md, "Wire format").
 //
 //   offset size field
 //   0      2    magic 'S' 'L' (0x53 0x4C)
@@ -26,7 +26,7 @@ namespace swarmlio::net {
 
 inline constexpr uint8_t kMagic0 = 0x53;  // 'S'
 inline constexpr uint8_t kMagic1 = 0x4C;  // 'L'
-inline constexpr uint8_t kProtocolVersion = 1;
+inline constexpr uint8_t kProtocolVersion = 2;  // 2: gravity in GlobalExtrinsic
 inline constexpr size_t kHeaderBytes = 12;
 inline constexpr size_t kTagBytes = 32;  // crypto_auth_hmacsha512256_BYTES
 inline constexpr size_t kPacketOverheadBytes = kHeaderBytes + kTagBytes;
@@ -47,9 +47,10 @@ struct PacketHeader {
 //   count u8 | count x { observed id u8 | p_bk_in_bj f32x3 | cov f32x6 }
 inline constexpr size_t kEgoStateFixedBytes = 8 + 8 + 16 + 24 + 12 + 12 + 3 * 24 + 1 + 1;
 inline constexpr size_t kObservationBytes = 1 + 12 + 24;
-// GlobalExtrinsic: stamp i64 | count u8 | count x { teammate id u8 | source u8 |
-//   q_Gi_Gj f32x4 | p_Gj_in_Gi f64x3 | covariance upper triangle f32x21 }
-inline constexpr size_t kGlobalExtrinsicFixedBytes = 8 + 1;
+// GlobalExtrinsic: stamp i64 | g_in_Gi f32x3 | cov_g_in_Gi f32x6 | count u8 |
+//   count x { teammate id u8 | source u8 | q_Gi_Gj f32x4 | p_Gj_in_Gi f64x3 |
+//   covariance upper triangle f32x21 }
+inline constexpr size_t kGlobalExtrinsicFixedBytes = 8 + 12 + 24 + 1;
 inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 16 + 24 + 21 * 4;
 // TimeSync: target id u8 | kind u8 (0 request, 1 response) | t1 t2 t3 i64
 inline constexpr size_t kTimeSyncBytes = 1 + 1 + 3 * 8;

@@ -75,6 +75,7 @@ struct DroneOutput {
   std::vector<int> removed_teammates;                // left the state in this scan
   int active_observations = 0;    // fused
   int passive_observations = 0;   // fused
+  int gravity_alignments = 0;     // teammates' gravity fused
   int rejected_observations = 0;  // gated out or unusable (no recent message)
   bool extrinsics_frozen = false; // degeneracy policy applied
   int num_detector_points = 0;    // full-resolution points given to the detector
@@ -88,6 +89,7 @@ struct DroneEstimatorCounters {
   int64_t teammates_removed = 0;
   int64_t active_fused = 0;
   int64_t passive_fused = 0;
+  int64_t gravity_fused = 0;
   int64_t observations_rejected = 0;
   int64_t front_end_errors = 0;
 };

@@ -38,6 +38,14 @@ struct SwarmOptions {
   bool fuse_active = true;
   /// Fuse passive observations (j saw me, from j's messages).
   bool fuse_passive = true;
+  /// Fuse each teammate's broadcast gravity (GlobalExtrinsic message, once
+  /// per message) with the own: R_Gi_Gj g_in_Gj = g_in_Gi fixes the tilt of
+  /// T_Gi_Gj (docs/swarm.md "Gravity alignment").
+  bool fuse_gravity = true;
+  /// 1-sigma added to the teammate's gravity covariance per component: the
+  /// same estimate comes back with every broadcast, its error correlated in
+  /// time [m/s^2] (0.02 m/s^2 ~ 0.12 deg of tilt).
+  double gravity_alignment_sigma_m_s2 = 0.02;
   /// Passive observations shift the own position by v (t_j - t_k); active
   /// ones predict j's broadcast state to the update time with its velocity
   /// and angular rate. Off: both taken as if made at the update time.
@@ -75,6 +83,10 @@ struct SwarmOptions {
     using config::FieldSpec;
     v("fuse_active", fuse_active, FieldSpec::Doc("fuse active observations (I see teammate j)"));
     v("fuse_passive", fuse_passive, FieldSpec::Doc("fuse passive observations (j saw me)"));
+    v("fuse_gravity", fuse_gravity,
+      FieldSpec::Doc("fuse the teammates' broadcast gravity with the own (tilt of T_Gi_Gj)"));
+    v("gravity_alignment_sigma_m_s2", gravity_alignment_sigma_m_s2,
+      FieldSpec::Positive("m/s^2", "1-sigma added to a teammate's gravity covariance"));
     v("time_compensation", time_compensation,
       FieldSpec::Doc("predict teammate states / shift passive observations to the update time"));
     v("max_message_age_s", max_message_age_s,
