@@ -26,6 +26,8 @@
 namespace swarmlio::swarm {
 namespace {
 
+constexpr double kGravity = 9.81;  // the simulator's default [m/s^2]
+
 Eigen::Isometry3d ToIsometry(const sim::Pose& pose) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = pose.R_W_b;
@@ -136,6 +138,7 @@ class ObserverSink : public sim::DroneSink {
   double restart_at_s = 1e9;  // the teammate reboots then (new session_start)
   double mutual_at_s = 1e9;   // from then on the teammate sends its T_Gj_Gi (it identified us)
   int indefinite_every_k = 0;  // every k-th broadcast has indefinite covariances (0: none)
+  int gravity_messages_delivered = 0;  // GlobalExtrinsic messages with the teammate's gravity
 
  private:
   // Broadcasts of the teammate that arrived (20 ms after its scan end) by `now_ns`.
@@ -188,8 +191,12 @@ class ObserverSink : public sim::DroneSink {
         e.p_Gj_in_Gi = T_Gj_Gi.translation();
         e.covariance.diagonal() << 1.2e-5, 1.2e-5, 1.2e-5, 1e-4, 1e-4, 1e-4;
         g.entries.push_back(e);
+        // Its gravity in G_j (the simulator's W has z up).
+        g.g_in_Gi = T_Gj_W_.linear() * Eigen::Vector3d(0.0, 0.0, -kGravity);
+        g.cov_g_in_Gi = 1e-4 * Eigen::Matrix3d::Identity();
         r.message = g;
         EXPECT_TRUE(estimator_->AddMessage(r).ok());
+        ++gravity_messages_delivered;
       }
     }
   }
@@ -342,6 +349,13 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
   EXPECT_EQ(method, "teammate_match");
   EXPECT_NEAR(identified_s, 10.0, 0.3);
   EXPECT_GT(active, 5);  // the tracker started at the broadcast position finds the clusters
+  // The teammate's gravity (with every GlobalExtrinsic, 10 Hz here) is fused
+  // once per message, and only once the block exists (from 10 s on).
+  int gravity = 0;
+  for (const DroneOutput& o : sink.outputs) gravity += o.gravity_alignments;
+  EXPECT_EQ(gravity, run.estimator->counters().gravity_fused);
+  EXPECT_GT(gravity, 20);
+  EXPECT_LE(gravity, sink.gravity_messages_delivered);
   const DroneOutput& last = sink.outputs.back();
   ASSERT_EQ(last.teammates.size(), 1u);
   const Eigen::Isometry3d T_true =
