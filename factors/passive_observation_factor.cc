@@ -20,8 +20,13 @@ PassiveObservationFactor::PassiveObservationFactor(const Eigen::Vector3d& p_bi_i
                                                    const Eigen::Matrix3d& Sigma_theta_bj,
                                                    const Eigen::Matrix3d& Sigma_p_bj_in_Gj,
                                                    const EgoState& ego_lin,
-                                                   const GlobalExtrinsic& extrinsic_lin)
-    : p_bi_in_bj_(p_bi_in_bj), dt_(dt), R_Gj_bj_(R_Gj_bj), p_bj_in_Gj_(p_bj_in_Gj) {
+                                                   const GlobalExtrinsic& extrinsic_lin,
+                                                   const Eigen::Vector3d& displacement_to_tj)
+    : p_bi_in_bj_(p_bi_in_bj),
+      dt_(dt),
+      displacement_to_tj_(displacement_to_tj),
+      R_Gj_bj_(R_Gj_bj),
+      p_bj_in_Gj_(p_bj_in_Gj) {
   const Eigen::Matrix3d h0_hat = so3::Hat(Predict(ego_lin, extrinsic_lin));
   const Eigen::Matrix3d S = Sigma_obs + h0_hat * Sigma_theta_bj * h0_hat.transpose() +
                             R_Gj_bj_.transpose() * Sigma_p_bj_in_Gj * R_Gj_bj_;
@@ -32,7 +37,7 @@ PassiveObservationFactor::PassiveObservationFactor(const Eigen::Vector3d& p_bi_i
 Eigen::Vector3d PassiveObservationFactor::EgoPositionInGj(const EgoState& ego,
                                                           const GlobalExtrinsic& extrinsic) const {
   return RotationOf(extrinsic.q_Gi_Gj).transpose() *
-         (ego.p_b_in_G + ego.v_b_in_G * dt_ - extrinsic.p_Gj_in_Gi);
+         (ego.p_b_in_G + ego.v_b_in_G * dt_ + displacement_to_tj_ - extrinsic.p_Gj_in_Gi);
 }
 
 Eigen::Vector3d PassiveObservationFactor::Predict(const EgoState& ego,

@@ -6,11 +6,13 @@
 // teammate extrinsic (7) = [q_Gi_Gj (x y z w) | p_Gj_in_Gi].
 // Constants: the measurement z = p_bi_in_bj (in b_j [m]) taken by j at time
 // t_j (already in i's clock), the teammate's broadcast pose at t_j
-// (R_Gj_bj, p_bj_in_Gj), and dt = t_j - t_k [s] where t_k is the time of the
-// ego state. The ego position is moved to t_j with its velocity (constant-
-// velocity time compensation; dt = 0 switches it off):
+// (R_Gj_bj, p_bj_in_Gj), dt = t_j - t_k [s] where t_k is the time of the
+// ego state, and a constant displacement d [m] in G_i. The ego position is
+// moved to t_j with its velocity (constant-velocity time compensation), or by
+// d, the own dead-reckoned displacement from t_k back to t_j (the caller then
+// passes dt = 0); dt = 0 and d = 0 switch it off:
 //
-//   w = R_Gi_Gj^T (p_bi_in_Gi + v_bi_in_Gi dt - p_Gj_in_Gi)      (ego position in G_j)
+//   w = R_Gi_Gj^T (p_bi_in_Gi + v_bi_in_Gi dt + d - p_Gj_in_Gi)  (ego position in G_j)
 //   h = R_Gj_bj^T (w - p_bj_in_Gj)
 //   r = U^-1 (h - z),   S = U U^T (lower Cholesky),   |r|^2 = (h - z)^T S^-1 (h - z)
 //
@@ -58,7 +60,8 @@ class PassiveObservationFactor final
                            const Eigen::Matrix3d& Sigma_theta_bj,
                            const Eigen::Matrix3d& Sigma_p_bj_in_Gj,
                            const EgoState& ego_lin,
-                           const GlobalExtrinsic& extrinsic_lin);
+                           const GlobalExtrinsic& extrinsic_lin,
+                           const Eigen::Vector3d& displacement_to_tj = Eigen::Vector3d::Zero());
 
   bool Evaluate(double const* const* parameters,
                 double* residuals,
@@ -83,11 +86,12 @@ class PassiveObservationFactor final
   const Eigen::Matrix3d& sqrt_information() const { return sqrt_information_; }
 
  private:
-  // w = R_Gi_Gj^T (p_bi_in_Gi + v dt - p_Gj_in_Gi), the ego position at t_j in G_j.
+  // w = R_Gi_Gj^T (p_bi_in_Gi + v dt + d - p_Gj_in_Gi), the ego position at t_j in G_j.
   Eigen::Vector3d EgoPositionInGj(const EgoState& ego, const GlobalExtrinsic& extrinsic) const;
 
   Eigen::Vector3d p_bi_in_bj_;
   double dt_;
+  Eigen::Vector3d displacement_to_tj_;
   Eigen::Matrix3d R_Gj_bj_;
   Eigen::Vector3d p_bj_in_Gj_;
   Eigen::Matrix3d covariance_;

@@ -16,6 +16,7 @@
 #include "factors/active_observation_factor.h"
 #include "factors/gravity_alignment_factor.h"
 #include "factors/passive_observation_factor.h"
+#include "dead_reckoning.h"
 #include "observation_terms.h"
 #include "teammate_state.h"
 #include "swarmlio/lio/undistortion.h"
@@ -24,6 +25,7 @@
 namespace swarmlio::swarm {
 namespace {
 
+using internal::DeadReckoningTrack;
 using internal::FixedExtrinsicCost;
 using internal::Finite;
 using internal::InvertExtrinsic;
@@ -67,6 +69,11 @@ struct DroneEstimator::Impl {
   teammate::ScanResult detection;
   double last_detection_stamp_s = 0.0;
   double degenerate_average = 0.0;  // EMA of the own degeneracy flags
+  // Own dead-reckoned track: the propagated displacements within each scan
+  // chained across scans without the update's corrections, (stamp, s) [ns, m].
+  // s(t_j) - s(t_k) moves a passive observation's ego position from t_k back
+  // to t_j (docs/swarm.md section 8).
+  DeadReckoningTrack dead_reckoning;
   Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();
   // The scan in flight (between OnFrontEnd and OnScanDone).
   SwarmPart part;
@@ -389,6 +396,9 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
     ++counters_.teammates_removed;
   }
 
+  // The own track for the time compensation of passive observations.
+  im.dead_reckoning.Append(*scan.poses, so.max_message_age_s + 0.5);
+
   // 4. Observation factors.
   const bool frozen = so.degeneracy_policy == DegeneracyPolicy::kFreezeExtrinsics &&
                       scan.previous_scan_degenerate;
@@ -465,11 +475,19 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
         continue;
       }
       const GlobalExtrinsic& T = x->teammate(p.from);
+      // Own position at t_j: the dead-reckoned displacement d when the track
+      // covers t_j, else the constant-velocity shift v dt. (Measured on the
+      // wall-facing Avia: d beats v dt, d with the velocity column kept
+      // (p + v dt + (d - v_hat dt)) and d with dt^2 Sigma_v as noise; docs/swarm.md.)
+      Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
+      const Eigen::Matrix3d Sigma_obs = Regularized<3>(p.cov);
+      const bool reckoned =
+          so.time_compensation && im.dead_reckoning.Displacement(p.stamp_ns, t_k, &displacement);
       auto factor = std::make_unique<PassiveObservationFactor>(
-          p.p_bi_in_bj, so.time_compensation ? dt : 0.0,
-          p.sender.q_Gj_bj.normalized().toRotationMatrix(), p.sender.p_bj_in_Gj,
-          Regularized<3>(p.cov), Regularized<3>(p.sender.cov_theta_Gj_bj, 1e-10),
-          Regularized<3>(p.sender.cov_p_bj_in_Gj), x->ego, T);
+          p.p_bi_in_bj, so.time_compensation && !reckoned ? dt : 0.0,
+          p.sender.q_Gj_bj.normalized().toRotationMatrix(), p.sender.p_bj_in_Gj, Sigma_obs,
+          Regularized<3>(p.sender.cov_theta_Gj_bj, 1e-10), Regularized<3>(p.sender.cov_p_bj_in_Gj),
+          x->ego, T, displacement);
       const Eigen::Vector3d e = factor->Predict(x->ego, T) - p.p_bi_in_bj;
       const Eigen::Matrix3d S = factor->covariance();
       if (add(std::move(factor), p.from, e, S)) {

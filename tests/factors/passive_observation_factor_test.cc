@@ -73,8 +73,9 @@ Eigen::Vector3d PassivePrediction(const EgoState& ego,
                                   const GlobalExtrinsic& T,
                                   double dt,
                                   const Eigen::Matrix3d& R_Gj_bj,
-                                  const Eigen::Vector3d& p_bj_in_Gj) {
-  const Eigen::Vector3d p_bi_in_Gi_at_tj = ego.p_b_in_G + ego.v_b_in_G * dt;
+                                  const Eigen::Vector3d& p_bj_in_Gj,
+                                  const Eigen::Vector3d& d = Eigen::Vector3d::Zero()) {
+  const Eigen::Vector3d p_bi_in_Gi_at_tj = ego.p_b_in_G + ego.v_b_in_G * dt + d;
   const Eigen::Vector3d p_bi_in_Gj = T.R_Gi_Gj().transpose() * (p_bi_in_Gi_at_tj - T.p_Gj_in_Gi);
   return R_Gj_bj.transpose() * (p_bi_in_Gj - p_bj_in_Gj);
 }
@@ -85,6 +86,7 @@ struct Problem {
   EgoState ego;
   GlobalExtrinsic extrinsic;
   double dt;
+  Eigen::Vector3d d;  // constant displacement to t_j (the dead-reckoned alternative to v dt)
   Eigen::Matrix3d R_Gj_bj;
   Eigen::Vector3d p_bj_in_Gj;
   Eigen::Vector3d z;
@@ -99,9 +101,10 @@ struct Problem {
           double dt_s,
           bool exact_measurement)
       : ego(s->Ego(ego_angle)), extrinsic(s->Extrinsic(extrinsic_angle)), dt(dt_s) {
+    d = s->Gaussian3(0.05);
     R_Gj_bj = s->Rotation(teammate_angle).toRotationMatrix();
     p_bj_in_Gj = s->Gaussian3(8.0);
-    z = PassivePrediction(ego, extrinsic, dt, R_Gj_bj, p_bj_in_Gj);
+    z = PassivePrediction(ego, extrinsic, dt, R_Gj_bj, p_bj_in_Gj, d);
     if (!exact_measurement) z += s->Gaussian3(0.3);
     Sigma_obs = s->Covariance(0.1, 1e-3);
     Sigma_theta = s->Covariance(0.01, 1e-6);
@@ -111,12 +114,12 @@ struct Problem {
   }
   PassiveObservationFactor Factor() const {
     return PassiveObservationFactor(z, dt, R_Gj_bj, p_bj_in_Gj, Sigma_obs, Sigma_theta, Sigma_p,
-                                    ego_lin, extrinsic_lin);
+                                    ego_lin, extrinsic_lin, d);
   }
   // S written out from its definition, at h0 = h(ego_lin, extrinsic_lin).
   Eigen::Matrix3d S() const {
     const Eigen::Matrix3d H =
-        so3::Hat(PassivePrediction(ego_lin, extrinsic_lin, dt, R_Gj_bj, p_bj_in_Gj));
+        so3::Hat(PassivePrediction(ego_lin, extrinsic_lin, dt, R_Gj_bj, p_bj_in_Gj, d));
     return Sigma_obs + H * Sigma_theta * H.transpose() + R_Gj_bj.transpose() * Sigma_p * R_Gj_bj;
   }
 };
@@ -170,9 +173,10 @@ TEST(PassiveObservationFactor, TimeCompensationMovesTheEgoByItsVelocity) {
   Sampler s(3);
   const Problem pr(&s, -1.0, -1.0, -1.0, 0.08, true);
   const PassiveObservationFactor factor = pr.Factor();
-  // With dt, the prediction equals the dt = 0 prediction of the ego moved by v dt.
+  // With dt (and the displacement d), the prediction equals the dt = 0, d = 0
+  // prediction of the ego moved by v dt + d.
   EgoState moved = pr.ego;
-  moved.p_b_in_G += pr.ego.v_b_in_G * 0.08;
+  moved.p_b_in_G += pr.ego.v_b_in_G * 0.08 + pr.d;
   const PassiveObservationFactor no_compensation(pr.z, 0.0, pr.R_Gj_bj, pr.p_bj_in_Gj, pr.Sigma_obs,
                                                  pr.Sigma_theta, pr.Sigma_p, pr.ego_lin,
                                                  pr.extrinsic_lin);
@@ -196,7 +200,7 @@ TEST(PassiveObservationFactor, PredictionMatchesTheDefinition) {
     const EgoState other_ego = s.Ego(-1.0);
     const GlobalExtrinsic other_ext = s.Extrinsic(-1.0);
     EXPECT_NEAR((pr.Factor().Predict(other_ego, other_ext) -
-                 PassivePrediction(other_ego, other_ext, pr.dt, pr.R_Gj_bj, pr.p_bj_in_Gj))
+                 PassivePrediction(other_ego, other_ext, pr.dt, pr.R_Gj_bj, pr.p_bj_in_Gj, pr.d))
                     .norm(),
                 0.0, 1e-10);
   }
@@ -211,7 +215,7 @@ TEST(PassiveObservationFactor, WhitenedResidualIsTheMahalanobisDistance) {
     const GlobalExtrinsic ext = s.Extrinsic(-1.0);
     const Blocks b(ego, ext);
     const Eigen::Vector3d r = EvaluateResidual(factor, b);
-    const Eigen::Vector3d e = PassivePrediction(ego, ext, pr.dt, pr.R_Gj_bj, pr.p_bj_in_Gj) - pr.z;
+    const Eigen::Vector3d e = PassivePrediction(ego, ext, pr.dt, pr.R_Gj_bj, pr.p_bj_in_Gj, pr.d) - pr.z;
     const Eigen::Matrix3d S = pr.S();
     const double mahalanobis = e.dot(S.ldlt().solve(e));
     EXPECT_NEAR(r.squaredNorm(), mahalanobis, 1e-9 * mahalanobis);
@@ -282,7 +286,7 @@ TEST(PassiveObservationFactor, TangentJacobianIsTheStatedFormula) {
     const Eigen::Matrix3d R_e = pr.extrinsic.R_Gi_Gj();
     const Eigen::Matrix3d M = pr.R_Gj_bj.transpose() * R_e.transpose();
     const Eigen::Vector3d w =
-        R_e.transpose() * (pr.ego.p_b_in_G + pr.ego.v_b_in_G * pr.dt - pr.extrinsic.p_Gj_in_Gi);
+        R_e.transpose() * (pr.ego.p_b_in_G + pr.ego.v_b_in_G * pr.dt + pr.d - pr.extrinsic.p_Gj_in_Gi);
     Eigen::Matrix<double, 3, 18> H_ego = Eigen::Matrix<double, 3, 18>::Zero();
     H_ego.block<3, 3>(0, 3) = M;
     H_ego.block<3, 3>(0, 6) = M * pr.dt;

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# The lossy-network acceptance run (docs/results.md "Lossy network"): replays
+# scenarios already simulated by tools/run_scenarios.sh through a network
+# with 20 % loss and 100 ms latency (10 ms jitter) for network seeds 1-3 and
+# compares every drone's APE with the lossless swarm run.
+#
+#   tools/run_lossy_network.sh                      # wall_degenerate corridor indoor_3uav
+#   tools/run_lossy_network.sh wall_degenerate      # only the named ones
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
+OUT="${OUT:-$ROOT/results/scenarios}"
+REPLAY="$BUILD_DIR/tools/replay/swarmlio_replay"
+SEEDS="${SEEDS:-1 2 3}"
+LOSS="${LOSS:-0.2}"
+LATENCY_S="${LATENCY_S:-0.1}"
+[[ -x "$REPLAY" ]] || { echo "missing $REPLAY: run tools/swarmlio.sh setup first" >&2; exit 1; }
+if [[ $# -gt 0 ]]; then scenarios=("$@"); else scenarios=(wall_degenerate corridor indoor_3uav); fi
+
+ape() {  # ape <metrics.csv> <drone>: the SE(3)-aligned APE RMSE [m]
+  awk -F, -v d="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "ape_rmse_m") c = i }
+                     NR > 1 && $1 == d { printf "%.4f", $c }' "$1"
+}
+
+echo "| scenario | drone | lossless | network seeds ${SEEDS// / \/ } | worst change |"
+echo "|---|---|---:|---|---:|"
+for name in "${scenarios[@]}"; do
+  dir="$OUT/$name"
+  [[ -f "$dir/sim/swarm.yaml" && -f "$dir/swarm/metrics.csv" ]] ||
+    { echo "missing $dir/sim or $dir/swarm: run tools/run_scenarios.sh $name first" >&2; exit 1; }
+  for seed in $SEEDS; do
+    cfg="$dir/lossy_seed$seed.yaml"
+    printf 'network:\n  seed: %s\n  default_link: {latency_mean_s: %s, jitter_std_s: 0.01, loss_probability: %s}\n' \
+      "$seed" "$LATENCY_S" "$LOSS" > "$cfg"
+    "$REPLAY" --manifest "$dir/sim/swarm.yaml" --network_config "$cfg" \
+      --output_dir "$dir/lossy_seed$seed" --save_maps=false > "$dir/lossy_seed$seed.log" 2>&1 ||
+      echo "replay failed: $dir/lossy_seed$seed.log" >&2
+  done
+  for drone in $(awk -F, 'NR > 1 { print $1 }' "$dir/swarm/metrics.csv"); do
+    base=$(ape "$dir/swarm/metrics.csv" "$drone")
+    values=() worst=0
+    for seed in $SEEDS; do
+      v=$(ape "$dir/lossy_seed$seed/metrics.csv" "$drone")
+      values+=("${v:-n/a}")
+      worst=$(awk -v a="$v" -v b="$base" -v w="$worst" 'BEGIN { c = (a - b) / b * 100; print (c > w ? c : w) }')
+    done
+    joined=$(IFS=/; echo "${values[*]}")
+    printf '| %s | %s | %s | %s | %+.0f %% |\n' "$name" "$drone" "$base" "${joined//\// \/ }" "$worst"
+  done
+done
