@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The lossy-network acceptance run (docs/results.md "Lossy network"): replays
-# scenarios already simulated by tools/run_scenarios.sh through a network
+# scenarios already simulated by tools/run_scenarios.sh (their file seed, in
+# results/scenarios/<name>/seed<S>/) through a network
 # with 20 % loss and 100 ms latency (10 ms jitter) for network seeds 1-3 and
 # compares every drone's APE with the lossless swarm run.
 #
@@ -26,9 +27,10 @@ ape() {  # ape <metrics.csv> <drone>: the SE(3)-aligned APE RMSE [m]
 echo "| scenario | drone | lossless | network seeds ${SEEDS// / \/ } | worst change |"
 echo "|---|---|---:|---|---:|"
 for name in "${scenarios[@]}"; do
-  dir="$OUT/$name"
+  seed0=$(sed -nE '/^scenario:/,/^[a-z]/{s/.*seed: *([0-9]+).*/\1/p}' "$ROOT/configs/scenarios/$name.yaml" | head -n1)
+  dir="$OUT/$name/seed$seed0"
   [[ -f "$dir/sim/swarm.yaml" && -f "$dir/swarm/metrics.csv" ]] ||
-    { echo "missing $dir/sim or $dir/swarm: run tools/run_scenarios.sh $name first" >&2; exit 1; }
+    { echo "missing $dir/sim or $dir/swarm: run SEED_OFFSETS=0 tools/run_scenarios.sh $name first" >&2; exit 1; }
   for seed in $SEEDS; do
     cfg="$dir/lossy_seed$seed.yaml"
     printf 'network:\n  seed: %s\n  default_link: {latency_mean_s: %s, jitter_std_s: 0.01, loss_probability: %s}\n' \

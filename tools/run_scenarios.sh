@@ -1,17 +1,27 @@
 #!/usr/bin/env bash
-# Regenerates docs/results_scenarios.md: for every scenario in
-# configs/scenarios/, simulate it, replay it (swarm mode through the simulated
-# network, and the single-agent ablation), and collect the per-drone metrics
-# tables. Needs a Release build in $BUILD_DIR (tools/swarmlio.sh setup).
+# Regenerates docs/results_scenarios.md: every scenario in configs/scenarios/
+# x several scenario seeds x {swarm, single-agent}: simulate, replay (swarm
+# mode through the simulated network, and the single-agent ablation), and
+# tabulate per drone the mean and spread over the seeds. Needs a Release
+# build in $BUILD_DIR (tools/swarmlio.sh setup).
 #
 #   tools/run_scenarios.sh                 # all scenarios, results in results/scenarios/
 #   tools/run_scenarios.sh indoor_3uav     # only the named ones
+#   SEED_OFFSETS="0" tools/run_scenarios.sh    # only the seed in each file
+#   IMPERFECTIONS=ideal tools/run_scenarios.sh # the simulator preset (default: the scenario's)
+#
+# Seeds: the scenario file's own seed plus each offset in SEED_OFFSETS
+# (default "0 100 200"); the seed drives the sensor noise and the random
+# targets of the excitation flights. The tuning set is indoor_3uav with its
+# file seed (offset 0); every other row is held out (docs/results.md).
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
 OUT="${OUT:-$ROOT/results/scenarios}"
-DOC="$ROOT/docs/results_scenarios.md"
+DOC="${DOC:-$ROOT/docs/results_scenarios.md}"
+SEED_OFFSETS="${SEED_OFFSETS:-0 100 200}"
+IMPERFECTIONS="${IMPERFECTIONS:-}"
 SIM="$BUILD_DIR/tools/sim/swarmlio_sim"
 REPLAY="$BUILD_DIR/tools/replay/swarmlio_replay"
 
@@ -26,6 +36,30 @@ else
   for f in "$ROOT"/configs/scenarios/*.yaml; do scenarios+=("$(basename "$f" .yaml)"); done
 fi
 
+# The seed in a scenario file (block `  seed: N` or inline `seed: N` in the
+# `scenario:` line).
+file_seed() {
+  sed -nE '/^scenario:/,/^[a-z]/{s/.*seed: *([0-9]+).*/\1/p}' "$1" | head -n1
+}
+
+# stats <column> <drone> <csv files...>: "mean +- std (min-max)" of a column
+# of the metrics.csv files for one drone.
+stats() {
+  local column="$1" drone="$2"
+  shift 2
+  awk -F, -v col="$column" -v d="$drone" '
+    FNR == 1 { for (i = 1; i <= NF; ++i) if ($i == col) c = i; next }
+    $1 == d && c > 0 { v = $c + 0; n++; s += v; ss += v * v;
+                       if (n == 1 || v < lo) lo = v; if (n == 1 || v > hi) hi = v }
+    END {
+      if (n == 0) { printf "n/a"; exit }
+      m = s / n; var = ss / n - m * m; if (var < 0) var = 0
+      if (col == "nees_position") printf "%.2f (%.2f-%.2f)", m, lo, hi
+      else if (col ~ /time/) printf "%.2f", m
+      else printf "%.4f +- %.4f (%.4f-%.4f)", m, sqrt(var * n / (n > 1 ? n - 1 : 1)), lo, hi
+    }' "$@"
+}
+
 {
   echo "# Per-scenario results"
   echo
@@ -33,53 +67,85 @@ fi
   echo "$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown), Release build, 2-core machine,"
   echo "replays run on one core with \`taskset -c 0\`). Do not edit by hand."
   echo
-  echo "Per drone: APE of the position after SE(3) alignment, RPE of the position per 1 m,"
-  echo "per-scan time (median, 95th percentile) of updated scans, real-time factor (log time /"
-  echo "estimator time), mean position NEES (expected 3). Ground truth: the simulator's."
+  preset="${IMPERFECTIONS:-as in each scenario file (simulator default)}"
+  echo "Simulator preset: $preset. Seeds: each scenario's"
+  echo "file seed plus the offsets ${SEED_OFFSETS}. Tuning set: \`indoor_3uav\` with its file seed;"
+  echo "every other row is held out. Per drone over the seeds: APE RMSE of the position after"
+  echo "SE(3) alignment as mean +- sample std (min-max) [m], mean position NEES (expected 3) with"
+  echo "its range, and the mean of the per-run median per-scan time [ms]."
 } > "$DOC"
 
 for name in "${scenarios[@]}"; do
   scenario="$ROOT/configs/scenarios/$name.yaml"
-  dir="$OUT/$name"
-  echo "== $name" >&2
-  mkdir -p "$dir"
-  "$SIM" --scenario "$scenario" --output_dir "$dir/sim" > "$dir.sim.log" 2>&1
-  status=0
-  taskset -c 0 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/swarm" \
-    > "$dir.swarm.log" 2>&1 || status=$?
-  taskset -c 0 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/single" \
-    --single_agent --save_maps=false > "$dir.single.log" 2>&1 || status=$?
+  base_seed="$(file_seed "$scenario")"
+  [[ -n "$base_seed" ]] || { echo "no seed in $scenario" >&2; exit 1; }
+  echo "== $name (file seed $base_seed)" >&2
+  swarm_csvs=() single_csvs=() seeds=() notes=()
+  for offset in $SEED_OFFSETS; do
+    seed=$((base_seed + offset))
+    seeds+=("$seed")
+    dir="$OUT/$name/seed$seed"
+    mkdir -p "$dir"
+    variant="$dir/$name.yaml"
+    # Sensor presets resolve against the scenario file's parent directory.
+    ln -sf "$ROOT"/configs/*.yaml "$OUT/$name/"
+    sed -E "/^scenario:/,/^[a-z]/s/seed: *[0-9]+/seed: $seed/" "$scenario" > "$variant"
+    grep -qE "seed: $seed([^0-9]|\$)" "$variant" || { echo "could not set seed in $variant" >&2; exit 1; }
+    sim_args=(--scenario "$variant" --output_dir "$dir/sim")
+    [[ -n "$IMPERFECTIONS" ]] && sim_args+=(--imperfections "$IMPERFECTIONS")
+    "$SIM" "${sim_args[@]}" > "$dir/sim.log" 2>&1 || { notes+=("seed $seed: simulation failed"); continue; }
+    status=0
+    taskset -c 0 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/swarm" \
+      --save_maps=false > "$dir/swarm.log" 2>&1 || status=$?
+    taskset -c 0 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/single" \
+      --single_agent --save_maps=false > "$dir/single.log" 2>&1 || status=$?
+    [[ $status -eq 0 ]] || notes+=("seed $seed: replay exit status $status")
+    [[ -f "$dir/swarm/metrics.csv" ]] && swarm_csvs+=("$dir/swarm/metrics.csv")
+    [[ -f "$dir/single/metrics.csv" ]] && single_csvs+=("$dir/single/metrics.csv")
+  done
   {
     echo
-    echo "## $name"
+    echo "## $name (seeds ${seeds[*]})"
     echo
     echo '```sh'
-    echo "build/tools/sim/swarmlio_sim --scenario configs/scenarios/$name.yaml --output_dir $dir/sim"
-    echo "taskset -c 0 build/tools/replay/swarmlio_replay --manifest $dir/sim/swarm.yaml --output_dir $dir/swarm"
-    echo "taskset -c 0 build/tools/replay/swarmlio_replay --manifest $dir/sim/swarm.yaml --output_dir $dir/single --single_agent"
+    echo "# per seed S: configs/scenarios/$name.yaml with seed: S, in $OUT/$name/seedS/"
+    echo "build/tools/sim/swarmlio_sim --scenario $name.yaml --output_dir sim${IMPERFECTIONS:+ --imperfections $IMPERFECTIONS}"
+    echo "taskset -c 0 build/tools/replay/swarmlio_replay --manifest sim/swarm.yaml --output_dir swarm --save_maps=false"
+    echo "taskset -c 0 build/tools/replay/swarmlio_replay --manifest sim/swarm.yaml --output_dir single --single_agent --save_maps=false"
     echo '```'
     echo
-    if [[ $status -ne 0 ]]; then echo "Replay exit status $status (see $dir.swarm.log)."; echo; fi
-    echo "Swarm mode (mutual observations fused; messages through the simulated network):"
+    if [[ ${#notes[@]} -gt 0 ]]; then printf -- '- %s\n' "${notes[@]}"; fi
+    if [[ ${#swarm_csvs[@]} -eq 0 ]]; then echo "(no results)"; continue; fi
+    echo "| drone | APE swarm [m] | APE single-agent [m] | NEES swarm | NEES single | time swarm / single [ms] |"
+    echo "|---|---|---|---|---|---|"
+    for drone in $(awk -F, 'NR > 1 { print $1 }' "${swarm_csvs[0]}"); do
+      printf '| %s | %s | %s | %s | %s | %s / %s |\n' "$drone" \
+        "$(stats ape_rmse_m "$drone" "${swarm_csvs[@]}")" \
+        "$(stats ape_rmse_m "$drone" "${single_csvs[@]}")" \
+        "$(stats nees_position "$drone" "${swarm_csvs[@]}")" \
+        "$(stats nees_position "$drone" "${single_csvs[@]}")" \
+        "$(stats time_median_ms "$drone" "${swarm_csvs[@]}")" \
+        "$(stats time_median_ms "$drone" "${single_csvs[@]}")"
+    done
     echo
-    cat "$dir/swarm/metrics.md" 2>/dev/null || echo "(no table)"
+    echo "Teammates (swarm mode), per seed: pairs identified of all ordered pairs, latest"
+    echo "identification after the excitation start, and the worst extrinsic error at the end:"
     echo
-    echo "Teammates (swarm mode; docs/replay.md \"Swarm outputs\"):"
-    echo
-    if [[ -f "$dir/swarm/swarm.md" ]]; then
-      # Identified pairs only (swarm_40 has 1560 pairs), and how many were not.
-      grep -v '| never |' "$dir/swarm/swarm.md"
-      echo
-      echo "Pairs never identified: $(grep -c '| never |' "$dir/swarm/swarm.md" || true) of $(($(wc -l < "$dir/swarm/swarm.md") - 2))."
-    else
-      echo "(no table)"
-    fi
-    echo
-    echo "Single-agent ablation:"
-    echo
-    cat "$dir/single/metrics.md" 2>/dev/null || echo "(no table)"
-    echo
-    grep -E "degenerate\)|peak RSS" "$dir.single.log" | sed 's/^/    /' || true
+    echo "| seed | identified | latest [s] | worst extrinsic end [m / deg] |"
+    echo "|---|---|---|---|"
+    for seed in "${seeds[@]}"; do
+      md="$OUT/$name/seed$seed/swarm/swarm.md"
+      [[ -f "$md" ]] || { echo "| $seed | n/a | | |"; continue; }
+      awk -F'|' -v seed="$seed" 'NR > 2 {
+          total++
+          if ($4 ~ /never/) next
+          ident++
+          gsub(/ /, "", $5); if ($5 + 0 > latest) latest = $5 + 0
+          split($6, e, "/"); m = e[1] + 0; d = e[2] + 0
+          if (m > wm) wm = m; if (d > wd) wd = d
+        }
+        END { printf "| %s | %d / %d | %.1f | %.3f / %.2f |\n", seed, ident, total, latest, wm, wd }' "$md"
+    done
   } >> "$DOC"
 done
 echo "wrote $DOC" >&2
