@@ -306,6 +306,9 @@ struct GeneratorSpec {
 // checked, its values only once applied over the preset for each drone's
 // LiDAR type (ScenarioImperfections), since they may rely on the preset.
 struct DeferredImperfections {
+  // No `imperfections:` key, or a map without `preset:`: realistic (the
+  // simulator's default since the honest-accuracy issue; docs/simulator.md).
+  DeferredImperfections() { options.preset = ImperfectionPreset::kRealistic; }
   ImperfectionOptions options;
   template <class V>
   void VisitFields(V&& v) {

@@ -55,9 +55,24 @@ double AngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return so3::Log(Eigen::Matrix3d(a.transpose() * b)).norm() / kDeg;
 }
 
-TEST(Imperfections, DefaultIsIdeal) {
+TEST(Imperfections, DefaultIsRealistic) {
   Scenario s;
-  const Status status = ParseScenario(Scenario2(""), "x.yaml", &s);
+  Status status = ParseScenario(Scenario2(""), "x.yaml", &s);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(s.imperfections, ImperfectionPreset::kRealistic);
+  for (const DroneConfig& d : s.drones) {
+    EXPECT_GT(d.lidar.imperfections.angular_noise_deg, 0.0);
+    EXPECT_FALSE(d.calibration_error.rotation_rad.isZero(0.0));
+  }
+  // A map without `preset:` is the realistic preset with the keys over it.
+  status = ParseScenario(Scenario2("imperfections: {clock: {drift_sigma_ppm: 3}}\n"), "x.yaml", &s);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(s.imperfections, ImperfectionPreset::kRealistic);
+}
+
+TEST(Imperfections, IdealIsEveryEffectOff) {
+  Scenario s;
+  const Status status = ParseScenario(Scenario2("imperfections: ideal\n"), "x.yaml", &s);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(s.imperfections, ImperfectionPreset::kIdeal);
   for (const DroneConfig& d : s.drones) {
@@ -136,7 +151,7 @@ TEST(Imperfections, OverridesApplyOverThePreset) {
 
   // An ideal file with single values; the preset from outside.
   const std::string ideal_keys =
-      "imperfections: {lidar: {range_noise_per_m: 0.001}, clock: {drift_sigma_ppm: 3}}\n";
+      "imperfections: {preset: ideal, lidar: {range_noise_per_m: 0.001}, clock: {drift_sigma_ppm: 3}}\n";
   ScenarioOverrides realistic;
   realistic.imperfections = ImperfectionPreset::kRealistic;
   status = ParseScenario(Scenario2(ideal_keys), "x.yaml", &s, realistic);
@@ -164,14 +179,14 @@ TEST(Imperfections, ErrorsNameFileLineAndKey) {
       {"imperfections: bogus\n", "",
        "x.yaml:16: imperfections: unknown value 'bogus' (choices: ideal, realistic)"},
       {"imperfections: {lidar: {angular_noise: 1}}\n", "", "imperfections.lidar.angular_noise"},
-      {"imperfections:\n  lidar: {mixed_pixel_probability: 0.5}\n", "",
-       "x.yaml:17: imperfections.lidar.mixed_pixel_probability: needs a beam footprint"},
+      {"imperfections:\n  preset: ideal\n  lidar: {mixed_pixel_probability: 0.5}\n", "",
+       "x.yaml:18: imperfections.lidar.mixed_pixel_probability: needs a beam footprint"},
       {"imperfections:\n  calibration: {extrinsic_rotation_deg: [0.5, 0.2]}\n", "",
        "imperfections.calibration.extrinsic_rotation_deg: min must not exceed max"},
       {"imperfections:\n  imu: {timestamp_jitter_s: 1}\n", "",
        "x.yaml:17: imperfections.imu.timestamp_jitter_s: value 1 is out of range"},
-      {"", ", imperfections: {multi_return: true}",
-       "x.yaml:8: drones[0].lidar.imperfections.multi_return: needs a beam footprint"},
+      {"imperfections: ideal\n", ", imperfections: {multi_return: true}",
+       "drones[0].lidar.imperfections.multi_return: needs a beam footprint"},
   };
   for (const Case& c : cases) {
     Scenario s;
@@ -356,7 +371,8 @@ TEST(Imperfections, ClockDriftScalesEveryStamp) {
 
   Scenario s;
   ASSERT_TRUE(
-      ParseScenario(Scenario2("", "", "\n    clock_drift_ppm: 500\n    clock_offset_s: 0.25"),
+      ParseScenario(Scenario2("imperfections: ideal\n", "",
+                              "\n    clock_drift_ppm: 500\n    clock_offset_s: 0.25"),
                     "x.yaml", &s)
           .ok());
   Simulator sim(std::move(s.scene), s.drones, s.objects, s.simulation_config());

@@ -1,9 +1,9 @@
 // Sensor imperfections of the simulator, grouped for a scenario's
 // `imperfections:` section (docs/simulator.md, "Imperfections"):
 //
-//   imperfections: realistic          # or ideal (the default: every effect off)
+//   imperfections: ideal              # or realistic (the default; ideal: every effect off)
 //   imperfections:                    # a preset with single values overridden
-//     preset: realistic
+//     preset: realistic               # the default preset when the key is omitted
 //     lidar: {mixed_pixel_probability: 0.2}
 //     imu: {timestamp_jitter_s: 0}
 //     calibration: {extrinsic_rotation_deg: [0.5, 0.5]}
