@@ -24,30 +24,6 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Undamped Gauss-Newton with Ceres's trust-region minimizer: one step per
-// Solve, Levenberg-Marquardt with a radius of 1e16 so that the damping
-// diag(J^T J) / radius is 1e-16 relative (docs/esikf.md).
-ceres::Solver::Options GaussNewtonSolverOptions(const EsikfUpdateOptions& options) {
-  ceres::Solver::Options s;
-  s.minimizer_type = ceres::TRUST_REGION;
-  s.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  s.initial_trust_region_radius = 1e16;
-  s.max_trust_region_radius = 1e16;
-  s.min_lm_diagonal = 1e-32;
-  s.max_lm_diagonal = 1e32;
-  s.min_relative_decrease = 0.0;  // accept every step that does not raise the cost
-  s.max_num_iterations = 1;       // exactly one Gauss-Newton step per Solve
-  s.function_tolerance = 0.0;     // never stop before taking the step
-  s.gradient_tolerance = 0.0;
-  s.parameter_tolerance = 0.0;
-  s.linear_solver_type = options.linear_solver;
-  s.dense_linear_algebra_library_type = ceres::EIGEN;
-  s.num_threads = 1;
-  s.minimizer_progress_to_stdout = false;
-  s.logging_type = ceres::SILENT;
-  return s;
-}
-
 // Ceres parameter storage of a SwarmState, in layout order.
 class ParameterBlocks {
  public:
@@ -121,6 +97,30 @@ Eigen::MatrixXd Gather(const Eigen::MatrixXd& P, const std::vector<int>& rows,
 }
 
 }  // namespace
+
+// Undamped Gauss-Newton with Ceres's trust-region minimizer: one step per
+// Solve, Levenberg-Marquardt with a radius of 1e16 so that the damping
+// diag(J^T J) / radius is 1e-16 relative (docs/esikf.md).
+ceres::Solver::Options GaussNewtonStepOptions(ceres::LinearSolverType linear_solver) {
+  ceres::Solver::Options s;
+  s.minimizer_type = ceres::TRUST_REGION;
+  s.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  s.initial_trust_region_radius = 1e16;
+  s.max_trust_region_radius = 1e16;
+  s.min_lm_diagonal = 1e-32;
+  s.max_lm_diagonal = 1e32;
+  s.min_relative_decrease = 0.0;  // accept every step that does not raise the cost
+  s.max_num_iterations = 1;       // exactly one Gauss-Newton step per Solve
+  s.function_tolerance = 0.0;     // never stop before taking the step
+  s.gradient_tolerance = 0.0;
+  s.parameter_tolerance = 0.0;
+  s.linear_solver_type = linear_solver;
+  s.dense_linear_algebra_library_type = ceres::EIGEN;
+  s.num_threads = 1;
+  s.minimizer_progress_to_stdout = false;
+  s.logging_type = ceres::SILENT;
+  return s;
+}
 
 PlaneMeasurementModel::PlaneMeasurementModel(PlaneAssociationFn associate)
     : associate_(std::move(associate)), factor_(&correspondences_) {}
@@ -377,7 +377,7 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
   std::vector<size_t> model_terms;  // terms of model k: [model_terms[k], model_terms[k + 1])
   std::vector<double*> term_pointers;
 
-  const ceres::Solver::Options solver_options = GaussNewtonSolverOptions(options_);
+  const ceres::Solver::Options solver_options = GaussNewtonStepOptions(options_.linear_solver);
   SwarmState x = x_start;
   for (int it = 0; it < options_.max_iterations; ++it) {
     // Drop last iteration's measurement blocks, re-linearize every model at x.

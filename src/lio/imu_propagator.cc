@@ -142,6 +142,7 @@ Status ImuPropagator::Reset(const SwarmState& state,
   P_ = P;
   stamp_ns_ = sample.stamp_ns;
   last_sample_stamp_ns_ = sample.stamp_ns;
+  last_sample_ = sample;
   last_input_ = u;
   acceleration_to_m_s2_ = acceleration_to_m_s2;
   initialized_ = true;
@@ -182,6 +183,7 @@ Status ImuPropagator::AddImu(const ImuSample& sample) {
     // input from here on.
     last_input_ = u;
     last_sample_stamp_ns_ = sample.stamp_ns;
+    last_sample_ = sample;
     scan_poses_.back() = CurrentPose(u);
     return Status::Ok();
   }
@@ -201,6 +203,7 @@ Status ImuPropagator::AddImu(const ImuSample& sample) {
   Step(mid, StampSeconds(sample.stamp_ns - stamp_ns_), sample.stamp_ns);
   last_input_ = u;
   last_sample_stamp_ns_ = sample.stamp_ns;
+  last_sample_ = sample;
   // The new pose's held input is the sample itself until the next step.
   scan_poses_.back() = CurrentPose(u);
   return Status::Ok();

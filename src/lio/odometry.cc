@@ -12,6 +12,7 @@
 #include "swarmlio/lio/preprocess.h"
 #include "swarmlio/lio/scan_association.h"
 #include "swarmlio/lio/undistortion.h"
+#include "window_smoother.h"
 
 namespace swarmlio::lio {
 namespace {
@@ -52,6 +53,7 @@ struct Odometry::Impl {
   LocalMap map;
   ScanAssociator associator;
   EsikfUpdate update;
+  std::unique_ptr<internal::WindowSmoother> window;  // estimator: window
   std::deque<ImuSample> imu_queue;  // after initialization, not yet propagated
   std::deque<PendingScan> scan_queue;
   std::deque<PendingScan> static_start_scans;  // before initialization (map seeding)
@@ -82,6 +84,11 @@ Status Odometry::Create(const OdometryOptions& options, const LidarOptions& lida
   SWARMLIO_RETURN_IF_ERROR(ImuPropagator::Create(options.propagation, &out->impl_->propagator));
   out->impl_->preprocess = std::make_unique<Preprocess>(
       options.preprocess, lidar.QuaternionImuLidar().toRotationMatrix(), lidar.p_lidar_in_imu_m);
+  if (options.estimator == EstimatorKind::kWindow) {
+    SWARMLIO_RETURN_IF_ERROR(internal::WindowSmoother::Create(
+        options.window, options.propagation, options.association, options.update,
+        &out->impl_->map, &out->impl_->window));
+  }
   *odometry = std::move(out);
   return Status::Ok();
 }
@@ -205,7 +212,42 @@ void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
   im.map.Insert(points_in_G);
 }
 
-Status Odometry::Flush() { return ProcessReadyScans(/*flush=*/true); }
+Status Odometry::Flush() {
+  const Status status = ProcessReadyScans(/*flush=*/true);
+  if (impl_->window != nullptr) {
+    // The scans still in the window enter the map at their current estimates.
+    std::vector<internal::LeavingScan> scans;
+    impl_->window->TakeScansForMap(&scans);
+    for (const internal::LeavingScan& s : scans) {
+      InsertScan(s.points_in_b, s.state, s.excluded, nullptr);
+    }
+  }
+  return status;
+}
+
+int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const EgoState& x,
+                         const std::vector<ExcludedRegion>& excluded,
+                         std::vector<Eigen::Vector3d>* registered_out) {
+  const Eigen::Matrix3d R_G_b = x.q_G_b.toRotationMatrix();
+  std::vector<Eigen::Vector3d> registered;
+  registered.reserve(points_in_b.size());
+  int num_excluded = 0;
+  for (const Eigen::Vector3d& p : points_in_b) {
+    bool inside = false;
+    for (const ExcludedRegion& region : excluded) {
+      inside |= (p - region.center_in_b).squaredNorm() <= region.radius_m * region.radius_m;
+    }
+    if (inside) {
+      ++num_excluded;
+      continue;
+    }
+    registered.push_back(R_G_b * p + x.p_b_in_G);
+  }
+  impl_->map.UpdateCenter(x.p_b_in_G);
+  impl_->map.Insert(registered);
+  if (registered_out != nullptr) *registered_out = std::move(registered);
+  return num_excluded;
+}
 
 Status Odometry::ProcessReadyScans(bool flush) {
   Status first_error;
@@ -243,10 +285,16 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
                                    " ns ends before the current state time; dropped");
   }
   prop.StartScan();
+  if (im.window != nullptr) {
+    // The window's IMU factor integrates exactly what the propagator consumes.
+    im.window->StartInterval(prop.stamp_ns(), prop.last_sample(),
+                             im.initialization.acceleration_to_m_s2, prop.state().ego);
+  }
   Status first_error;
   while (!im.imu_queue.empty() && im.imu_queue.front().stamp_ns <= end_ns) {
     const ImuSample sample = im.imu_queue.front();
     im.imu_queue.pop_front();
+    if (im.window != nullptr) im.window->AddImu(sample);
     Status status = prop.AddImu(sample);
     if (status.code() == Status::Code::kOutOfRange) {
       // A gap in the IMU stream: hold the state and restart from this sample.
@@ -260,6 +308,7 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
     }
   }
   const ImuSample* next = im.imu_queue.empty() ? nullptr : &im.imu_queue.front();
+  if (im.window != nullptr) im.window->IntegrateTo(end_ns, next);
   if (Status status = prop.PropagateTo(end_ns, next); !status.ok()) {
     if (!flush || status.code() != Status::Code::kOutOfRange) return status;
     // Flushing past the end of the IMU data: hold the state at its last time.
@@ -292,7 +341,32 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
     out.timings.front_end_s = SecondsSince(t);
   }
 
-  // 4. Update.
+  // 4. Update, 4b + 5. map.
+  if (im.window != nullptr) {
+    UpdateWithWindow(request, &x, &P, &out);
+  } else {
+    UpdateWithFilter(request, &x, &P, &out);
+  }
+  out.map_size = im.map.size();
+
+  out.stamp_ns = prop.stamp_ns();
+  out.state = x.ego;
+  out.covariance = P.topLeftCorner<ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>();
+  out.timings.total_s = SecondsSince(t_start);
+  im.last_scan_end_ns = end_ns;
+  im.have_scan = true;
+  ++counters_.scans_processed;
+  if (hooks_ != nullptr) hooks_->OnScanDone(out, x, P);
+  im.outputs.push_back(std::move(out));
+  return first_error;
+}
+
+void Odometry::UpdateWithFilter(const UpdateRequest& request, SwarmState* x_io,
+                                Eigen::MatrixXd* P_io, ScanOutput* out) {
+  Impl& im = *impl_;
+  SwarmState& x = *x_io;
+  Eigen::MatrixXd& P = *P_io;
+  ImuPropagator& prop = *im.propagator;
   const bool map_ready = !im.map.empty();
   const bool enough_points = static_cast<int>(im.undistorted.size()) >= options_.min_scan_points;
   if (map_ready && enough_points) {
@@ -305,26 +379,26 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
     models.insert(models.end(), request.models.begin(), request.models.end());
     const EsikfUpdateResult result =
         im.update.Run(x, P, models, hooks_ != nullptr ? &request.estimated_teammates : nullptr);
-    out.timings.association_s = result.association_time_s;
-    out.timings.solve_s = result.solve_time_s;
-    out.timings.covariance_s = result.covariance_time_s;
-    out.iterations = result.iterations;
-    out.converged = result.converged;
-    out.num_correspondences = static_cast<int>(planes.correspondences().size());
-    out.num_measurement_blocks = result.num_residual_blocks;
-    out.min_normal_information = im.associator.stats().MinNormalInformation();
-    out.degenerate = out.min_normal_information < options_.association.degeneracy_threshold;
+    out->timings.association_s = result.association_time_s;
+    out->timings.solve_s = result.solve_time_s;
+    out->timings.covariance_s = result.covariance_time_s;
+    out->iterations = result.iterations;
+    out->converged = result.converged;
+    out->num_correspondences = static_cast<int>(planes.correspondences().size());
+    out->num_measurement_blocks = result.num_residual_blocks;
+    out->min_normal_information = im.associator.stats().MinNormalInformation();
+    out->degenerate = out->min_normal_information < options_.association.degeneracy_threshold;
     if (result.status.ok() && IsFinite(result.state, result.covariance)) {
       x = result.state;
       P = result.covariance;
-      out.updated = true;
+      out->updated = true;
       ++counters_.scans_updated;
-      if (out.degenerate) ++counters_.scans_degenerate;
-      im.previous_degenerate = out.degenerate;
+      if (out->degenerate) ++counters_.scans_degenerate;
+      im.previous_degenerate = out->degenerate;
       prop.SetState(x, P);
     } else {
       ++counters_.updates_failed;
-      out.update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
+      out->update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
     }
   }
 
@@ -332,39 +406,94 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
   // points in the excluded regions (teammates). Only updated scans and the
   // very first one grow the map, so a failed update cannot write a
   // misregistered scan into it.
-  t = Clock::now();
-  if (out.updated || !map_ready) {
-    const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
-    std::vector<Eigen::Vector3d> registered;
-    registered.reserve(im.undistorted.size());
-    for (const Eigen::Vector3d& p : im.undistorted) {
-      bool excluded = false;
-      for (const ExcludedRegion& region : request.excluded) {
-        excluded |= (p - region.center_in_b).squaredNorm() <= region.radius_m * region.radius_m;
-      }
-      if (excluded) {
-        ++out.num_excluded_points;
-        continue;
-      }
-      registered.push_back(R_G_b * p + x.ego.p_b_in_G);
-    }
-    im.map.UpdateCenter(x.ego.p_b_in_G);
-    im.map.Insert(registered);
-    if (options_.output_registered_scan) out.registered_in_G = std::move(registered);
+  const Clock::time_point t = Clock::now();
+  if (out->updated || !map_ready) {
+    out->num_excluded_points = InsertScan(
+        im.undistorted, x.ego, request.excluded,
+        options_.output_registered_scan ? &out->registered_in_G : nullptr);
   }
-  out.map_size = im.map.size();
-  out.timings.map_update_s = SecondsSince(t);
+  out->timings.map_update_s = SecondsSince(t);
+}
 
-  out.stamp_ns = prop.stamp_ns();
-  out.state = x.ego;
-  out.covariance = P.topLeftCorner<ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>();
-  out.timings.total_s = SecondsSince(t_start);
-  im.last_scan_end_ns = end_ns;
-  im.have_scan = true;
-  ++counters_.scans_processed;
-  if (hooks_ != nullptr) hooks_->OnScanDone(out, x, P);
-  im.outputs.push_back(std::move(out));
-  return first_error;
+void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
+                                Eigen::MatrixXd* P_io, ScanOutput* out) {
+  Impl& im = *impl_;
+  SwarmState& x = *x_io;
+  Eigen::MatrixXd& P = *P_io;
+  ImuPropagator& prop = *im.propagator;
+  const bool enough_points = static_cast<int>(im.undistorted.size()) >= options_.min_scan_points;
+
+  // The state joins the window; the states beyond K leave it, marginalized.
+  internal::WindowStateInput input;
+  input.stamp_ns = prop.stamp_ns();
+  input.x_pred = x;
+  input.P_pred = P;
+  input.points_in_b = im.undistorted;
+  input.use_planes = enough_points;
+  input.excluded = request.excluded;
+  input.models = request.models;
+  std::vector<internal::LeavingScan> leaving;
+  std::string model_error;
+  const Status added = im.window->AddState(std::move(input), &leaving, &out->timings.marginalize_s,
+                                           &model_error);
+  if (!model_error.empty()) {
+    out->hook_error += (out->hook_error.empty() ? "" : "; ") + model_error;
+  }
+
+  // Map: the scans that left, at their final estimates (only scans that a
+  // solve updated; docs/window.md "Map"). An empty map is built from the
+  // newest scan at its prediction, like the filter's first scan.
+  Clock::time_point t = Clock::now();
+  for (const internal::LeavingScan& l : leaving) {
+    if (l.insert) InsertScan(l.points_in_b, l.state, l.excluded, nullptr);
+  }
+  if (im.map.empty()) {
+    out->num_excluded_points = InsertScan(im.undistorted, x.ego, request.excluded, nullptr);
+    if (added.ok()) im.window->MarkNewestInMap();
+  }
+  out->timings.map_update_s = SecondsSince(t);
+  if (!added.ok()) {
+    ++counters_.updates_failed;
+    out->update_error = added.message();
+    return;
+  }
+
+  const internal::WindowSolveResult result = im.window->Solve();
+  out->timings.build_s = result.build_s;
+  out->timings.association_s = result.association_s;
+  out->timings.solve_s = result.solve_s;
+  out->timings.covariance_s = result.covariance_s;
+  out->iterations = result.iterations;
+  out->converged = result.converged;
+  out->num_correspondences = result.num_correspondences;
+  out->num_measurement_blocks = result.num_residual_blocks;
+  const bool attempted = result.updated || result.iterations > 0;
+  if (attempted && enough_points) {
+    out->min_normal_information = result.newest_stats.MinNormalInformation();
+    out->degenerate = out->min_normal_information < options_.association.degeneracy_threshold;
+  }
+  counters_.window_restarts = im.window->counters().restarts;
+  counters_.window_reintegrations = im.window->counters().reintegrations;
+  if (result.status.ok() && IsFinite(result.state, result.covariance)) {
+    x = result.state;
+    P = result.covariance;
+    prop.SetState(x, P);
+    out->updated = result.updated;
+    if (out->updated) {
+      ++counters_.scans_updated;
+      if (out->degenerate) ++counters_.scans_degenerate;
+      im.previous_degenerate = out->degenerate;
+    }
+  } else if (enough_points) {
+    ++counters_.updates_failed;
+    out->update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
+  }
+  if (options_.output_registered_scan) {
+    const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
+    for (const Eigen::Vector3d& p : im.undistorted) {
+      out->registered_in_G.push_back(R_G_b * p + x.ego.p_b_in_G);
+    }
+  }
 }
 
 }  // namespace swarmlio::lio

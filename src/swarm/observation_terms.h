@@ -51,6 +51,13 @@ class MutualObservationModel final : public MeasurementModel {
     for (size_t k = 0; k < costs_.size(); ++k) terms->push_back({costs_[k].get(), blocks_[k]});
     return Status::Ok();
   }
+  bool ReleaseTerms(std::vector<OwnedResidualTerm>* terms) override {
+    for (size_t k = 0; k < costs_.size(); ++k) {
+      terms->push_back({std::move(costs_[k]), std::move(blocks_[k])});
+    }
+    Clear();
+    return true;
+  }
   void Clear() {
     costs_.clear();
     blocks_.clear();

@@ -23,6 +23,7 @@
 // them), so the cost grows with the teammates observed, not with the swarm.
 #pragma once
 
+#include <ceres/solver.h>
 #include <ceres/types.h>
 
 #include <Eigen/Core>
@@ -65,6 +66,12 @@ struct EsikfUpdateOptions {
   /// "" when valid, else "key: reason".
   std::string Validate() const;
 };
+
+/// Ceres options for exactly one undamped Gauss-Newton step per Solve: the
+/// trust-region minimizer with Levenberg-Marquardt at a radius of 1e16, no
+/// stopping tolerance, one thread, silent (docs/esikf.md, "Gauss-Newton
+/// configuration of Ceres"). The update's and the window smoother's solver.
+ceres::Solver::Options GaussNewtonStepOptions(ceres::LinearSolverType linear_solver);
 
 /// Fills `out` (cleared by the caller) with the plane correspondences of the
 /// scan at the estimate x. A non-ok Status aborts the update.

@@ -147,6 +147,9 @@ class ImuPropagator {
   const SwarmState& state() const { return state_; }
   const Eigen::MatrixXd& covariance() const { return P_; }
   int64_t stamp_ns() const { return stamp_ns_; }
+  /// The last accepted IMU sample (raw units): the input held at stamp_ns()
+  /// (the window smoother's preintegration starts from it).
+  const ImuSample& last_sample() const { return last_sample_; }
   bool initialized() const { return initialized_; }
   /// Poses of the current scan: the state at StartScan(), then one per
   /// propagation step (IMU samples, then the PropagateTo() target).
@@ -175,6 +178,7 @@ class ImuPropagator {
   Eigen::MatrixXd P_;
   int64_t stamp_ns_ = 0;
   int64_t last_sample_stamp_ns_ = 0;  // stamp of the last accepted IMU sample
+  ImuSample last_sample_;             // that sample (raw units)
   ImuInput last_input_;               // that sample's input (SI units)
   double acceleration_to_m_s2_ = 1.0;
   std::vector<ImuPose> scan_poses_;

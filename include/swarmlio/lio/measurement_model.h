@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <vector>
 
 #include "swarmlio/common/status.h"
@@ -33,6 +34,15 @@ inline constexpr int kEgoBlock = -1;
 struct ResidualTerm {
   const ceres::CostFunction* cost = nullptr;  // owned by the model, valid until its next Linearize
   /// State blocks in the cost's parameter order: kEgoBlock or a teammate id.
+  std::vector<int> blocks;
+};
+
+/// A residual block handed over for good, to a back end that keeps it after
+/// its scan (the fixed-lag window smoother, docs/window.md).
+struct OwnedResidualTerm {
+  std::unique_ptr<ceres::CostFunction> cost;
+  /// State blocks in the cost's parameter order: kEgoBlock (the block of the
+  /// scan the model belongs to) or a teammate id.
   std::vector<int> blocks;
 };
 
@@ -53,6 +63,16 @@ class MeasurementModel {
   virtual bool AddInformation(const SwarmState& x, Eigen::MatrixXd* information) const {
     (void)x;
     (void)information;
+    return false;
+  }
+  /// For a model whose residual blocks are the same wherever they are
+  /// evaluated (exact functions of the state, noise fixed when the model was
+  /// built: the mutual observations): moves them into `*terms` and returns
+  /// true, so that a fixed-lag window can keep them while their scan stays
+  /// in the window. The default returns false (the model must be
+  /// re-linearized, e.g. point-to-plane re-associates) and moves nothing.
+  virtual bool ReleaseTerms(std::vector<OwnedResidualTerm>* terms) {
+    (void)terms;
     return false;
   }
 };

@@ -13,6 +13,10 @@
 //   4b. points in the hooks' excluded regions (teammates) are removed;
 //   5. insert the registered points into the local map, move the map box.
 // The first scan after IMU initialization only builds the map.
+// With `estimator: window` steps 4-5 are the fixed-lag window smoother's
+// (docs/window.md): the scan's state joins the window, the state that leaves
+// it is marginalized and its scan inserted into the map, then the window is
+// solved; the output is the newest state and its marginal covariance.
 //
 // Before the first scan can be used the IMU must initialize from a static
 // window (ImuInitializer); scans before that are dropped and counted.
@@ -40,11 +44,14 @@ struct ScanTimings {
   double preprocess_s = 0.0;   // filters + voxel downsampling
   double propagate_s = 0.0;    // IMU propagation over the scan
   double undistort_s = 0.0;    // motion compensation
-  double association_s = 0.0;  // kNN + plane fits, all iterations
+  double association_s = 0.0;  // kNN + plane fits, all iterations (window: all its scans)
   double solve_s = 0.0;        // ceres::Solve, all iterations
-  double covariance_s = 0.0;   // posterior covariance
+  double covariance_s = 0.0;   // posterior covariance (window: the newest state's marginal)
   double front_end_s = 0.0;    // the hooks' front end (teammate detection, models)
   double map_update_s = 0.0;   // registration into G + map insertion + box move
+  // The window back end only (0 with the filter; docs/window.md):
+  double build_s = 0.0;        // IMU re-integration + problem construction
+  double marginalize_s = 0.0;  // adding the state, marginalizing the states that leave
   double total_s = 0.0;        // whole scan, including everything above
 };
 
@@ -89,6 +96,9 @@ struct OdometryCounters {
   int64_t scans_updated = 0;
   int64_t scans_degenerate = 0;      // updated scans flagged degenerate
   int64_t updates_failed = 0;        // update refused (prediction kept)
+  // The window back end only:
+  int64_t window_restarts = 0;       // restarted from the propagator (IMU gap, failed factor)
+  int64_t window_reintegrations = 0; // IMU factors preintegrated again at new biases
 };
 
 class Odometry {
@@ -145,6 +155,17 @@ class Odometry {
   Status ProcessReadyScans(bool flush);
   void SeedMapFromStaticStart(int64_t window_start_ns);
   Status ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush);
+  // Steps 4-5 of ProcessScan with each back end: x, P in = the prediction,
+  // out = the posterior (or the prediction when not updated).
+  void UpdateWithFilter(const UpdateRequest& request, SwarmState* x, Eigen::MatrixXd* P,
+                        ScanOutput* out);
+  void UpdateWithWindow(const UpdateRequest& request, SwarmState* x, Eigen::MatrixXd* P,
+                        ScanOutput* out);
+  // Registers the points with x, inserts all but the excluded ones into the
+  // map (moving its box to x) and returns how many were excluded.
+  int InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const EgoState& x,
+                 const std::vector<ExcludedRegion>& excluded,
+                 std::vector<Eigen::Vector3d>* registered_in_G);
 
   OdometryOptions options_;
   LidarOptions lidar_;

@@ -12,17 +12,23 @@
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/preprocess.h"
 #include "swarmlio/lio/scan_association.h"
+#include "swarmlio/lio/window_options.h"
 #include "swarmlio/sensors/lidar_options.h"
 
 namespace swarmlio::lio {
 
 struct OdometryOptions {
+  /// The back end: the iterated filter update (default) or the fixed-lag
+  /// window smoother (docs/window.md) over the same factors.
+  EstimatorKind estimator = EstimatorKind::kFilter;
   ImuInitializerOptions imu_init;
   ImuPropagatorOptions propagation;
   PreprocessOptions preprocess;
   LocalMapOptions map;
   AssociationOptions association;
   EsikfUpdateOptions update;
+  /// The window smoother (used when estimator is window).
+  WindowOptions window;
   /// IMU stamps are this much later than the LiDAR's clock; subtracted from
   /// every IMU stamp (FAST-LIO time_offset_lidar_to_imu) [s].
   double imu_time_offset_s = 0.0;
@@ -44,12 +50,15 @@ struct OdometryOptions {
   template <class V>
   void VisitFields(V&& v) {
     using config::FieldSpec;
+    v("estimator", estimator,
+      FieldSpec::Doc("back end: filter (iterated ESIKF) or window (fixed-lag smoother)"));
     v("imu_init", imu_init);
     v("propagation", propagation);
     v("preprocess", preprocess);
     v("map", map);
     v("association", association);
     v("update", update);
+    v("window", window);
     v("imu_time_offset_s", imu_time_offset_s,
       FieldSpec::InRange(-1.0, 1.0, "s", "subtracted from IMU stamps (IMU clock minus LiDAR clock)"));
     v("min_scan_points", min_scan_points,

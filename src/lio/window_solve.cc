@@ -1,0 +1,285 @@
+// WindowSmoother::Solve and the newest state's marginal covariance
+// (docs/window.md, "The window", steps 3 and 4).
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <vector>
+
+#include "window_smoother.h"
+#include "window_state.h"
+
+namespace swarmlio::lio::internal {
+namespace {
+
+ceres::LinearSolverType ToCeres(WindowLinearSolver solver) {
+  switch (solver) {
+    case WindowLinearSolver::kDenseQr:
+      return ceres::DENSE_QR;
+    case WindowLinearSolver::kDenseSchur:
+      return ceres::DENSE_SCHUR;
+    case WindowLinearSolver::kSparseNormalCholesky:
+      return ceres::SPARSE_NORMAL_CHOLESKY;
+    case WindowLinearSolver::kDenseNormalCholesky:
+      break;
+  }
+  return ceres::DENSE_NORMAL_CHOLESKY;
+}
+
+// Adds J^T J of one residual block at the blocks' current values (tangent
+// Jacobians: ambient Jacobian times PlusJacobian) to H at the blocks' offsets.
+bool AddBlockInformation(const ceres::CostFunction& cost, const std::vector<double*>& blocks,
+                         const std::vector<const ceres::Manifold*>& manifolds,
+                         const std::vector<int>& offsets, Eigen::MatrixXd* H) {
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const int m = cost.num_residuals();
+  const size_t nb = blocks.size();
+  std::vector<RowMajor> ambient(nb);
+  std::vector<double*> jacobians(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    ambient[b].resize(m, manifolds[b]->AmbientSize());
+    jacobians[b] = ambient[b].data();
+  }
+  Eigen::VectorXd residuals(m);
+  if (!cost.Evaluate(blocks.data(), residuals.data(), jacobians.data())) return false;
+  std::vector<Eigen::MatrixXd> tangent(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    RowMajor plus(manifolds[b]->AmbientSize(), manifolds[b]->TangentSize());
+    if (!manifolds[b]->PlusJacobian(blocks[b], plus.data())) return false;
+    tangent[b] = ambient[b] * plus;
+    if (!tangent[b].allFinite()) return false;
+  }
+  for (size_t a = 0; a < nb; ++a) {
+    for (size_t b = 0; b < nb; ++b) {
+      H->block(offsets[a], offsets[b], tangent[a].cols(), tangent[b].cols()) +=
+          tangent[a].transpose() * tangent[b];
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+void WindowSmoother::Impl::ReintegrateImu() {
+  for (size_t i = 1; i < scans.size(); ++i) {
+    WindowScan& s = *scans[i];
+    const EgoState previous = scans[i - 1]->State();
+    const PreintegratedImu& pre = s.imu->preintegrated();
+    if ((previous.gyro_bias - pre.gyro_bias_lin).norm() <= options.reintegrate_gyro_bias_rad_s &&
+        (previous.accel_bias - pre.accel_bias_lin).norm() <= options.reintegrate_accel_bias_m_s2) {
+      continue;
+    }
+    s.imu->Reintegrate(previous.gyro_bias, previous.accel_bias);
+    std::unique_ptr<ImuPreintegrationFactor> factor;
+    if (ImuPreintegrationFactor::Create(s.imu->preintegrated(), &factor).ok()) {
+      s.imu_factor = std::move(factor);
+      ++counters.reintegrations;
+    }
+  }
+}
+
+std::vector<double> WindowSmoother::Impl::Values() const {
+  std::vector<double> v;
+  for (const auto& s : scans) v.insert(v.end(), s->ego.begin(), s->ego.end());
+  for (const auto& t : teammates) v.insert(v.end(), t->x.begin(), t->x.end());
+  return v;
+}
+
+void WindowSmoother::Impl::Restore(const std::vector<double>& values) {
+  auto it = values.begin();
+  for (auto& s : scans) {
+    std::copy(it, it + EgoState::kAmbientSize, s->ego.begin());
+    it += EgoState::kAmbientSize;
+  }
+  for (auto& t : teammates) {
+    std::copy(it, it + GlobalExtrinsic::kAmbientSize, t->x.begin());
+    it += GlobalExtrinsic::kAmbientSize;
+  }
+}
+
+void WindowSmoother::Impl::ReadState(SwarmState* x) const {
+  *x = SwarmState();
+  x->ego = scans.back()->State();
+  for (const auto& t : teammates) x->AddTeammate(t->id, GlobalExtrinsic::FromParameters(t->x.data()));
+}
+
+Status WindowSmoother::Impl::NewestCovariance(Eigen::MatrixXd* P) const {
+  const int n = static_cast<int>(scans.size());
+  const int dim = kEgoDim * n + kTeammateDim * static_cast<int>(teammates.size());
+  std::unordered_map<const double*, int> offsets;
+  for (int i = 0; i < n; ++i) offsets[scans[static_cast<size_t>(i)]->ego.data()] = kEgoDim * i;
+  for (size_t j = 0; j < teammates.size(); ++j) {
+    offsets[teammates[j]->x.data()] = kEgoDim * n + kTeammateDim * static_cast<int>(j);
+  }
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
+  const auto add = [&](const ceres::CostFunction& cost, const std::vector<double*>& blocks,
+                       const std::vector<const ceres::Manifold*>& manifolds) {
+    std::vector<int> o;
+    for (double* b : blocks) o.push_back(offsets.at(b));
+    return AddBlockInformation(cost, blocks, manifolds, o, &H);
+  };
+  bool ok = true;
+  for (const Prior& p : priors) ok = ok && add(*p.factor, p.blocks, p.manifolds);
+  for (int i = 0; i < n; ++i) {
+    const WindowScan& s = *scans[static_cast<size_t>(i)];
+    double* ego = const_cast<double*>(s.ego.data());
+    if (i > 0) {
+      double* previous = scans[static_cast<size_t>(i - 1)]->ego.data();
+      ok = ok && add(*s.imu_factor, {previous, ego}, {&ego_manifold, &ego_manifold});
+    }
+    if (s.HasPlaneInformation()) ok = ok && add(s.compressed, {ego}, {&ego_manifold});
+    for (const OwnedResidualTerm& term : s.observations) {
+      std::vector<double*> blocks;
+      std::vector<const ceres::Manifold*> manifolds;
+      for (int b : term.blocks) {
+        blocks.push_back(BlockOf(s, b));
+        manifolds.push_back(ManifoldOf(b));
+      }
+      ok = ok && add(*term.cost, blocks, manifolds);
+    }
+  }
+  if (!ok) return Status::Internal("window: Jacobian evaluation failed (covariance)");
+  const Eigen::LLT<Eigen::MatrixXd> llt(H);
+  if (llt.info() != Eigen::Success) {
+    return Status::Internal("window: information matrix is not positive definite");
+  }
+  // The newest ego block and the teammate blocks: the trailing columns.
+  const int first = kEgoDim * (n - 1);
+  const int m = dim - first;
+  const Eigen::MatrixXd E = Eigen::MatrixXd::Identity(dim, dim).rightCols(m);
+  Eigen::MatrixXd cov = llt.solve(E).bottomRows(m);
+  *P = 0.5 * (cov + cov.transpose());
+  return Status::Ok();
+}
+
+WindowSolveResult WindowSmoother::Solve() {
+  Impl& im = *impl_;
+  WindowSolveResult result;
+  if (im.scans.empty()) {
+    result.status = Status::FailedPrecondition("window: no state");
+    return result;
+  }
+  const Clock::time_point t_build = Clock::now();
+  im.ReintegrateImu();
+  std::vector<WindowScan*> active;
+  if (!im.map->empty()) {
+    for (auto& s : im.scans) {
+      if (!s->use_planes || s->in_map) continue;
+      s->associator->Reset(&s->points_in_b);  // the map changed since the last solve
+      active.push_back(s.get());
+    }
+  }
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  for (auto& s : im.scans) {
+    problem.AddParameterBlock(s->ego.data(), EgoState::kAmbientSize, &im.ego_manifold);
+  }
+  for (auto& t : im.teammates) {
+    problem.AddParameterBlock(t->x.data(), GlobalExtrinsic::kAmbientSize, &im.teammate_manifold);
+  }
+  for (const Prior& p : im.priors) problem.AddResidualBlock(p.factor.get(), nullptr, p.blocks);
+  for (size_t i = 1; i < im.scans.size(); ++i) {
+    problem.AddResidualBlock(im.scans[i]->imu_factor.get(), nullptr, im.scans[i - 1]->ego.data(),
+                             im.scans[i]->ego.data());
+  }
+  for (WindowScan* s : active) problem.AddResidualBlock(&s->compressed, nullptr, s->ego.data());
+  for (auto& s : im.scans) {
+    for (const OwnedResidualTerm& term : s->observations) {
+      std::vector<double*> blocks;
+      for (int b : term.blocks) blocks.push_back(im.BlockOf(*s, b));
+      problem.AddResidualBlock(term.cost.get(), nullptr, blocks);
+      ++result.num_residual_blocks;
+    }
+  }
+  result.num_residual_blocks += static_cast<int>(active.size());
+  result.build_s = SecondsSince(t_build);
+
+  if (!active.empty()) {
+    const std::vector<double> before = im.Values();
+    ceres::Solver::Options solver_options = GaussNewtonStepOptions(ToCeres(im.options.linear_solver));
+    solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+    for (int it = 0; it < im.options.max_iterations; ++it) {
+      const Clock::time_point t_assoc = Clock::now();
+      for (WindowScan* s : active) {
+        SwarmState at;
+        at.ego = s->State();
+        result.status = s->associator->Associate(at, &s->correspondences);
+        if (!result.status.ok()) break;
+        s->stats = s->associator->stats();
+        s->RefreshPlanes();
+      }
+      result.association_s += SecondsSince(t_assoc);
+      if (!result.status.ok()) break;
+      const std::vector<double> start = im.Values();
+      const Clock::time_point t_solve = Clock::now();
+      ceres::Solver::Summary summary;
+      ceres::Solve(solver_options, &problem, &summary);
+      result.solve_s += SecondsSince(t_solve);
+      if (!summary.IsSolutionUsable()) {
+        result.status = Status::Internal("window: Ceres failed: " + summary.message);
+        break;
+      }
+      ++result.iterations;
+      result.num_rejected_steps += summary.num_unsuccessful_steps;
+      if (summary.num_unsuccessful_steps > 0) break;
+      // Converged when every state's step is below the filter's thresholds.
+      bool small = true;
+      size_t offset = 0;
+      for (const auto& s : im.scans) {
+        const EgoState old_x = EgoState::FromParameters(start.data() + offset);
+        const auto dx = s->State().BoxMinus(old_x);
+        small = small && dx.segment<3>(ErrorStateLayout::kRotation.offset).norm() <
+                             im.update.convergence_rotation_rad;
+        small = small && dx.segment<3>(ErrorStateLayout::kPosition.offset).norm() <
+                             im.update.convergence_translation_m;
+        offset += EgoState::kAmbientSize;
+      }
+      for (const auto& t : im.teammates) {
+        const GlobalExtrinsic old_T = GlobalExtrinsic::FromParameters(start.data() + offset);
+        const auto dx = GlobalExtrinsic::FromParameters(t->x.data()).BoxMinus(old_T);
+        small = small && dx.head<3>().norm() < im.update.convergence_rotation_rad &&
+                dx.tail<3>().norm() < im.update.convergence_translation_m;
+        offset += GlobalExtrinsic::kAmbientSize;
+      }
+      if (small) {
+        result.converged = true;
+        break;
+      }
+    }
+    const std::vector<double> after = im.Values();
+    const bool finite = std::all_of(after.begin(), after.end(),
+                                    [](double v) { return std::isfinite(v); });
+    if (result.status.ok() && !finite) {
+      result.status = Status::Internal("window: non-finite solution");
+    }
+    if (!result.status.ok()) im.Restore(before);
+    for (WindowScan* s : active) {
+      if (result.status.ok()) s->updated = true;
+      s->RefreshPlanes();  // at the final (or restored) value, for covariance and marginalization
+    }
+    WindowScan& newest = *im.scans.back();
+    const bool newest_active = std::find(active.begin(), active.end(), &newest) != active.end();
+    if (newest_active) {
+      result.updated = result.status.ok();
+      result.num_correspondences = static_cast<int>(newest.correspondences.size());
+      result.newest_stats = newest.stats;
+    }
+  }
+
+  const Clock::time_point t_cov = Clock::now();
+  im.ReadState(&result.state);
+  const Status covariance = im.NewestCovariance(&result.covariance);
+  if (!covariance.ok()) {
+    result.updated = false;
+    if (result.status.ok()) result.status = covariance;
+  }
+  result.covariance_s = SecondsSince(t_cov);
+  return result;
+}
+
+}  // namespace swarmlio::lio::internal

@@ -1,0 +1,136 @@
+// The state of the fixed-lag window smoother (src/lio/window_smoother.h):
+// its scans, teammate blocks and priors, shared by window_smoother.cc
+// (adding states, marginalization) and window_solve.cc (the solve and the
+// newest covariance). Internal to swarmlio_lio.
+#pragma once
+
+#include <ceres/manifold.h>
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "factors/ego_state_manifold.h"
+#include "factors/global_extrinsic_manifold.h"
+#include "factors/imu_preintegration_factor.h"
+#include "factors/marginalization_prior_factor.h"
+#include "factors/point_to_plane_factor.h"
+#include "factors/pose_information_factor.h"
+#include "swarmlio/lio/imu_preintegration.h"
+#include "swarmlio/window/marginalization.h"
+#include "window_smoother.h"
+
+namespace swarmlio::lio::internal {
+
+using Clock = std::chrono::steady_clock;
+using EgoParameters = std::array<double, EgoState::kAmbientSize>;
+using TeammateParameters = std::array<double, GlobalExtrinsic::kAmbientSize>;
+constexpr int kEgoDim = EgoState::kTangentSize;
+constexpr int kTeammateDim = GlobalExtrinsic::kTangentSize;
+
+inline double SecondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// One scan state of the window.
+struct WindowScan {
+  int64_t stamp_ns = 0;
+  EgoParameters ego{};
+  std::vector<Eigen::Vector3d> points_in_b;
+  std::vector<ExcludedRegion> excluded;
+  bool use_planes = false;  // enough points
+  bool in_map = false;      // its points are in the map (it built the map, or was flushed)
+  bool updated = false;     // its planes were in a successful solve
+  std::unique_ptr<ScanAssociator> associator;
+  std::vector<PlaneCorrespondence> correspondences;  // of the last association
+  PointToPlaneFactor planes{&correspondences};       // the point rows (normal equations)
+  PoseInformationFactor compressed;                  // what Ceres and the marginalizer see
+  AssociationStats stats;
+  std::unique_ptr<ImuPreintegration> imu;  // from the previous state (none for the first)
+  std::unique_ptr<ImuPreintegrationFactor> imu_factor;
+  std::vector<OwnedResidualTerm> observations;  // the hooks' terms at this state
+
+  EgoState State() const { return EgoState::FromParameters(ego.data()); }
+  // The plane information of a successful solve, linearized at the current value.
+  bool HasPlaneInformation() const { return updated && !correspondences.empty(); }
+  // Re-linearizes the compressed rows at the current value (same correspondences).
+  void RefreshPlanes() {
+    const EgoState x = State();
+    Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+    planes.AccumulateNormalEquations(x, &A, &b);
+    compressed.Set(A, b, x.q_G_b, x.p_b_in_G);
+  }
+};
+
+struct TeammateBlock {
+  int id = 0;
+  TeammateParameters x{};
+};
+
+// A prior over some blocks: the first state's (from the filter's prediction)
+// or a marginalization's.
+struct Prior {
+  std::unique_ptr<MarginalizationPriorFactor> factor;
+  std::vector<double*> blocks;
+  std::vector<const ceres::Manifold*> manifolds;
+
+  bool Touches(const double* block) const {
+    return std::find(blocks.begin(), blocks.end(), block) != blocks.end();
+  }
+};
+
+struct WindowSmoother::Impl {
+  WindowOptions options;
+  ImuPreintegrationOptions preintegration;
+  AssociationOptions association;
+  EsikfUpdateOptions update;
+  const LocalMap* map = nullptr;
+  EgoStateManifold ego_manifold;
+  GlobalExtrinsicManifold teammate_manifold;
+  MarginalizationPriorFactorOptions prior_options;
+  std::unique_ptr<Marginalizer> marginalizer;
+  std::deque<std::unique_ptr<WindowScan>> scans;
+  std::vector<std::unique_ptr<TeammateBlock>> teammates;  // the newest prediction's layout order
+  std::vector<Prior> priors;
+  std::unique_ptr<ImuPreintegration> interval;  // being integrated towards the next state
+  bool interval_ok = false;
+  WindowCounters counters;
+
+  double* Teammate(int id) const {
+    for (const auto& t : teammates) {
+      if (t->id == id) return t->x.data();
+    }
+    return nullptr;
+  }
+  Status AddGaussianPrior(const std::vector<double*>& blocks,
+                          const std::vector<const ceres::Manifold*>& manifolds,
+                          const Eigen::MatrixXd& covariance);
+  Status AddPrior(const MarginalizationPrior& prior);
+  void Leave(WindowScan* scan, std::vector<LeavingScan>* leaving);
+  Status Restart(WindowStateInput* input, std::vector<LeavingScan>* leaving);
+  Status SyncTeammates(const SwarmState& x_pred, const Eigen::MatrixXd& P_pred);
+  Status RemoveTeammate(int id);
+  Status MarginalizeOldest(std::vector<LeavingScan>* leaving);
+  Status TakeObservations(WindowStateInput* input, WindowScan* scan);
+  Status AddState(WindowStateInput* input, std::vector<LeavingScan>* leaving,
+                  std::string* model_error);
+  void ReintegrateImu();
+  Status NewestCovariance(Eigen::MatrixXd* P) const;
+  void ReadState(SwarmState* x) const;
+  std::vector<double> Values() const;
+  void Restore(const std::vector<double>& values);
+  double* BlockOf(const WindowScan& scan, int block) const {
+    return block == kEgoBlock ? const_cast<double*>(scan.ego.data()) : Teammate(block);
+  }
+  const ceres::Manifold* ManifoldOf(int block) const {
+    return block == kEgoBlock ? static_cast<const ceres::Manifold*>(&ego_manifold)
+                              : &teammate_manifold;
+  }
+};
+
+}  // namespace swarmlio::lio::internal
