@@ -218,5 +218,37 @@ TEST(WindowOdometry, OptionsAreValidated) {
             Status::Code::kInvalidArgument);
 }
 
+// The YAML keys of a drone entry select the back end per drone.
+TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
+  const std::string presets = std::string(SWARMLIO_SOURCE_DIR) + "/configs/";
+  const std::string yaml =
+      "name: flight\n"
+      "drones:\n"
+      "  - name: a\n"
+      "    bag: a.bag\n"
+      "    sensor_preset: " + presets + "livox_mid360.yaml\n"
+      "    odometry: {estimator: window, window: {size: 7, linear_solver: sparse_normal_cholesky}}\n"
+      "  - name: b\n"
+      "    bag: b.bag\n"
+      "    sensor_preset: " + presets + "livox_avia.yaml\n";
+  replay::SwarmManifest m;
+  const Status status = replay::ParseManifest(yaml, "/data/swarm.yaml", &m);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(m.drones.size(), 2u);
+  EXPECT_EQ(m.drones[0].odometry.estimator, lio::EstimatorKind::kWindow);
+  EXPECT_EQ(m.drones[0].odometry.window.size, 7);
+  EXPECT_EQ(m.drones[0].odometry.window.linear_solver,
+            lio::WindowLinearSolver::kSparseNormalCholesky);
+  EXPECT_EQ(m.drones[1].odometry.estimator, lio::EstimatorKind::kFilter);
+  const std::string bad =
+      "drones:\n"
+      "  - name: a\n"
+      "    bag: a.bag\n"
+      "    odometry: {estimator: smoother}\n";
+  const Status refused = replay::ParseManifest(bad, "/data/swarm.yaml", &m);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("estimator"), std::string::npos) << refused.message();
+}
+
 }  // namespace
 }  // namespace swarmlio

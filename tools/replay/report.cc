@@ -49,7 +49,7 @@ Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord
   out << "stamp_s,updated,raw_points,points,correspondences,iterations,min_normal_information,"
          "degenerate,map_points,preprocess_ms,propagate_ms,undistort_ms,association_ms,solve_ms,"
          "covariance_ms,map_update_ms,total_ms,front_end_ms,active_fused,passive_fused,"
-         "rejected_observations,extrinsics_frozen\n";
+         "rejected_observations,extrinsics_frozen,build_ms,marginalize_ms\n";
   out << std::fixed;
   for (const replay::ScanRecord& s : scans) {
     const lio::ScanTimings& t = s.timings;
@@ -61,7 +61,8 @@ Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord
         << 1e3 * t.association_s << "," << 1e3 * t.solve_s << "," << 1e3 * t.covariance_s << ","
         << 1e3 * t.map_update_s << "," << 1e3 * t.total_s << "," << 1e3 * t.front_end_s << ","
         << s.active_observations << "," << s.passive_observations << ","
-        << s.rejected_observations << "," << (s.extrinsics_frozen ? 1 : 0) << "\n";
+        << s.rejected_observations << "," << (s.extrinsics_frozen ? 1 : 0) << ","
+        << 1e3 * t.build_s << "," << 1e3 * t.marginalize_s << "\n";
   }
   return out ? Status::Ok() : Status::IoError(path + ": write failed");
 }

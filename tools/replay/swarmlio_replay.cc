@@ -41,6 +41,16 @@ DEFINE_double(max_duration_s, 0.0, "replay only this much log time [s]; 0 = all"
 DEFINE_bool(save_maps, true, "write <name>_map.pcd per drone");
 DEFINE_bool(single_agent, false,
             "ablation: every drone runs alone (no messages), as single-agent odometry");
+DEFINE_string(estimator, "",
+              "back end of every drone: filter | window (docs/window.md); default: each "
+              "drone's odometry.estimator");
+DEFINE_int32(window_size, 0,
+             "K (scan states) of the window back end for every drone; 0: each drone's "
+             "odometry.window.size");
+DEFINE_string(window_linear_solver, "",
+              "linear solver of the window for every drone: dense_normal_cholesky | dense_qr | "
+              "dense_schur | sparse_normal_cholesky; default: each drone's "
+              "odometry.window.linear_solver");
 DEFINE_string(network_config, "",
               "YAML file with a `network:` section (latency, jitter, loss, reordering, "
               "duplication, seed; docs/network.md); default: the NetworkOptions defaults");
@@ -55,6 +65,28 @@ std::vector<std::string> Split(const std::string& s) {
     if (!item.empty()) out.push_back(item);
   }
   return out;
+}
+
+// The back-end flags, applied to every drone's odometry options.
+Status ApplyEstimatorFlags(replay::SwarmManifest* manifest) {
+  for (replay::DroneInput& d : manifest->drones) {
+    lio::OdometryOptions& o = d.odometry;
+    if (!FLAGS_estimator.empty() && !config::EnumFromString(FLAGS_estimator, &o.estimator)) {
+      return Status::InvalidArgument("--estimator=" + FLAGS_estimator + ": expected one of " +
+                                     config::EnumChoices<lio::EstimatorKind>());
+    }
+    if (FLAGS_window_size != 0) o.window.size = FLAGS_window_size;
+    if (!FLAGS_window_linear_solver.empty() &&
+        !config::EnumFromString(FLAGS_window_linear_solver, &o.window.linear_solver)) {
+      return Status::InvalidArgument("--window_linear_solver=" + FLAGS_window_linear_solver +
+                                     ": expected one of " +
+                                     config::EnumChoices<lio::WindowLinearSolver>());
+    }
+    if (const std::string invalid = o.Validate(); !invalid.empty()) {
+      return Status::InvalidArgument(d.name + ": odometry." + invalid);
+    }
+  }
+  return Status::Ok();
 }
 
 struct StageStats {
@@ -93,12 +125,26 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
                                  {"propagate", &lio::ScanTimings::propagate_s},
                                  {"undistort", &lio::ScanTimings::undistort_s},
                                  {"front end", &lio::ScanTimings::front_end_s},
+                                 {"build", &lio::ScanTimings::build_s},
+                                 {"marginalize", &lio::ScanTimings::marginalize_s},
                                  {"association", &lio::ScanTimings::association_s},
                                  {"solve", &lio::ScanTimings::solve_s},
                                  {"covariance", &lio::ScanTimings::covariance_s},
                                  {"map", &lio::ScanTimings::map_update_s}};
+    const bool window = d.input().odometry.estimator == lio::EstimatorKind::kWindow;
+    if (window) {
+      std::printf("\n  window K = %d (%s), %lld restarts, %lld IMU re-integrations",
+                  d.input().odometry.window.size,
+                  config::EnumToString(d.input().odometry.window.linear_solver),
+                  static_cast<long long>(c.window_restarts),
+                  static_cast<long long>(c.window_reintegrations));
+    }
     std::printf("\n  median per stage [ms]:");
     for (const StageStats& st : stages) {
+      if (!window && (st.field == &lio::ScanTimings::build_s ||
+                      st.field == &lio::ScanTimings::marginalize_s)) {
+        continue;
+      }
       std::vector<double> v;
       for (const auto& s : scans) {
         if (s.updated) v.push_back(1e3 * (s.timings.*st.field));
@@ -178,6 +224,11 @@ int Main() {
                       ? replay::ManifestFromBags(Split(FLAGS_bags), FLAGS_sensor_preset,
                                                  Split(FLAGS_names), &manifest)
                       : replay::LoadManifest(FLAGS_manifest, &manifest);
+  if (!status.ok()) {
+    std::fprintf(stderr, "error: %s\n", status.message().c_str());
+    return 1;
+  }
+  status = ApplyEstimatorFlags(&manifest);
   if (!status.ok()) {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());
     return 1;
