@@ -70,6 +70,12 @@ Status ImuPreintegration::Reset(int64_t start_stamp_ns,
   return Status::Ok();
 }
 
+double ImuPreintegration::SumOfSquaredSteps() const {
+  double sum = 0.0;
+  for (const Step& step : steps_) sum += step.dt_s * step.dt_s;
+  return sum;
+}
+
 void ImuPreintegration::Restart(const Eigen::Vector3d& gyro_bias,
                                 const Eigen::Vector3d& accel_bias) {
   CHECK(initialized_) << "ImuPreintegration::Restart before Reset";

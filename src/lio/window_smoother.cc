@@ -24,6 +24,7 @@ Status WindowSmoother::Create(const WindowOptions& options, const ImuPropagatorO
   im.preintegration.process_noise = propagation.process_noise;
   im.preintegration.max_gap_s = propagation.max_gap_s;
   im.preintegration.gravity_stddev_floor_m_s2 = options.gravity_stddev_floor_m_s2;
+  im.process_noise = propagation.process_noise;
   if (const std::string invalid = im.preintegration.Validate(); !invalid.empty()) {
     return Status::InvalidArgument("window IMU preintegration (propagation options): " + invalid);
   }
@@ -59,36 +60,109 @@ void WindowSmoother::IntegrateTo(int64_t stamp_ns, const ImuSample* next_sample)
 
 void WindowSmoother::BreakInterval() { impl_->interval_ok = false; }
 
-Status WindowSmoother::Impl::AddPrior(const MarginalizationPrior& prior) {
-  Prior p;
-  SWARMLIO_RETURN_IF_ERROR(MarginalizationPriorFactor::Create(prior, prior_options, &p.factor));
-  p.blocks = prior.parameter_blocks;
-  p.manifolds = prior.manifolds;
-  priors.push_back(std::move(p));
+Status WindowSmoother::Impl::SetPrior(MarginalizationPrior system) {
+  std::unique_ptr<MarginalizationPriorFactor> factor;
+  SWARMLIO_RETURN_IF_ERROR(MarginalizationPriorFactor::Create(system, prior_options, &factor));
+  prior.system = std::move(system);
+  prior.factor = std::move(factor);
   return Status::Ok();
 }
 
-Status WindowSmoother::Impl::AddGaussianPrior(const std::vector<double*>& blocks,
-                                              const std::vector<const ceres::Manifold*>& manifolds,
-                                              const Eigen::MatrixXd& covariance) {
+namespace {
+
+// Information (and gradient 0) of N(current values, covariance) over blocks.
+Status GaussianSystem(const std::vector<double*>& blocks,
+                      const std::vector<const ceres::Manifold*>& manifolds,
+                      const Eigen::MatrixXd& covariance, MarginalizationPrior* system) {
   const Eigen::MatrixXd C = 0.5 * (covariance + covariance.transpose());
   const Eigen::LLT<Eigen::MatrixXd> llt(C);
   if (llt.info() != Eigen::Success || !C.allFinite()) {
     return Status::InvalidArgument("window: prior covariance is not positive definite");
   }
-  MarginalizationPrior prior;
-  prior.information = llt.solve(Eigen::MatrixXd::Identity(C.rows(), C.cols()));
-  prior.information = 0.5 * (prior.information + prior.information.transpose()).eval();
-  prior.gradient = Eigen::VectorXd::Zero(C.rows());
-  prior.parameter_blocks = blocks;
-  prior.manifolds = manifolds;
+  MarginalizationPrior& s = *system;
+  s = MarginalizationPrior();
+  s.information = llt.solve(Eigen::MatrixXd::Identity(C.rows(), C.cols()));
+  s.information = 0.5 * (s.information + s.information.transpose()).eval();
+  s.gradient = Eigen::VectorXd::Zero(C.rows());
+  s.parameter_blocks = blocks;
+  s.manifolds = manifolds;
   for (size_t b = 0; b < blocks.size(); ++b) {
     const int ambient = manifolds[b]->AmbientSize();
-    prior.linearization_points.push_back(Eigen::Map<const Eigen::VectorXd>(blocks[b], ambient));
-    prior.ambient_sizes.push_back(ambient);
-    prior.tangent_sizes.push_back(manifolds[b]->TangentSize());
+    s.linearization_points.push_back(Eigen::Map<const Eigen::VectorXd>(blocks[b], ambient));
+    s.ambient_sizes.push_back(ambient);
+    s.tangent_sizes.push_back(manifolds[b]->TangentSize());
   }
-  return AddPrior(prior);
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WindowSmoother::Impl::SetGaussianPrior(const std::vector<double*>& blocks,
+                                              const std::vector<const ceres::Manifold*>& manifolds,
+                                              const Eigen::MatrixXd& covariance) {
+  MarginalizationPrior system;
+  SWARMLIO_RETURN_IF_ERROR(GaussianSystem(blocks, manifolds, covariance, &system));
+  return SetPrior(std::move(system));
+}
+
+Status WindowSmoother::Impl::ExtendPrior(double* block, const ceres::Manifold* manifold,
+                                         const Eigen::MatrixXd& covariance) {
+  MarginalizationPrior extra;
+  SWARMLIO_RETURN_IF_ERROR(GaussianSystem({block}, {manifold}, covariance, &extra));
+  MarginalizationPrior s = prior.system;
+  const int n = static_cast<int>(s.gradient.size());
+  const int m = static_cast<int>(extra.gradient.size());
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n + m, n + m);
+  H.topLeftCorner(n, n) = s.information;
+  H.bottomRightCorner(m, m) = extra.information;
+  s.information = std::move(H);
+  s.gradient.conservativeResize(n + m);
+  s.gradient.tail(m).setZero();
+  s.parameter_blocks.push_back(block);
+  s.manifolds.push_back(manifold);
+  s.linearization_points.push_back(extra.linearization_points[0]);
+  s.ambient_sizes.push_back(extra.ambient_sizes[0]);
+  s.tangent_sizes.push_back(extra.tangent_sizes[0]);
+  return SetPrior(std::move(s));
+}
+
+void WindowSmoother::Impl::AddTeammateRandomWalk(double sum_dt2,
+                                                 MarginalizationPrior* system) const {
+  // x' = x + E w, w ~ N(0, Q): marginalizing w from 1/2 |x' - E w|^2_H + b^T (x' - E w)
+  // + 1/2 w^T Q^-1 w gives H' = H - H E M^-1 E^T H, b' = b - H E M^-1 E^T b,
+  // M = Q^-1 + E^T H E (the covariance form: P' = P + E Q E^T).
+  const double q_rotation = sum_dt2 * process_noise.teammate_rotation_cov_rad2_s2;
+  const double q_translation = sum_dt2 * process_noise.teammate_translation_cov_m2_s2;
+  if (!(q_rotation > 0.0) || !(q_translation > 0.0)) return;
+  std::vector<int> index;
+  std::vector<double> q;
+  int offset = 0;
+  for (size_t b = 0; b < system->parameter_blocks.size(); ++b) {
+    if (system->manifolds[b] == &teammate_manifold) {
+      for (int k = 0; k < kTeammateDim; ++k) {
+        index.push_back(offset + k);
+        q.push_back(k < 3 ? q_rotation : q_translation);
+      }
+    }
+    offset += system->tangent_sizes[b];
+  }
+  if (index.empty()) return;
+  const int n = offset;
+  const int m = static_cast<int>(index.size());
+  Eigen::MatrixXd HE(n, m);
+  for (int j = 0; j < m; ++j) HE.col(j) = system->information.col(index[static_cast<size_t>(j)]);
+  Eigen::MatrixXd M(m, m);
+  Eigen::VectorXd Eb(m);
+  for (int i = 0; i < m; ++i) {
+    M.row(i) = HE.row(index[static_cast<size_t>(i)]);
+    M(i, i) += 1.0 / q[static_cast<size_t>(i)];
+    Eb(i) = system->gradient(index[static_cast<size_t>(i)]);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(0.5 * (M + M.transpose()));
+  if (llt.info() != Eigen::Success) return;
+  system->information -= HE * llt.solve(HE.transpose());
+  system->information = 0.5 * (system->information + system->information.transpose()).eval();
+  system->gradient -= HE * llt.solve(Eb);
 }
 
 void WindowSmoother::Impl::Leave(WindowScan* scan, std::vector<LeavingScan>* leaving) {
@@ -135,7 +209,7 @@ Status WindowSmoother::Impl::Restart(WindowStateInput* input, std::vector<Leavin
   if (!scans.empty()) ++counters.restarts;
   for (auto& s : scans) Leave(s.get(), leaving);
   scans.clear();
-  priors.clear();
+  prior = Prior();
   teammates.clear();
   for (int id : input->x_pred.layout().teammate_ids()) {
     auto t = std::make_unique<TeammateBlock>();
@@ -152,7 +226,7 @@ Status WindowSmoother::Impl::Restart(WindowStateInput* input, std::vector<Leavin
     manifolds.push_back(&teammate_manifold);
   }
   scans.push_back(std::move(scan));
-  return AddGaussianPrior(blocks, manifolds, input->P_pred);
+  return SetGaussianPrior(blocks, manifolds, input->P_pred);
 }
 
 Status WindowSmoother::Impl::RemoveTeammate(int id) {
@@ -167,26 +241,18 @@ Status WindowSmoother::Impl::RemoveTeammate(int id) {
                              }),
               obs.end());
   }
-  // Its information in the priors moves onto their other blocks.
-  marginalizer->Clear();
-  std::vector<size_t> consumed;
-  std::vector<double*> others;
-  for (size_t k = 0; k < priors.size(); ++k) {
-    if (!priors[k].Touches(T)) continue;
-    consumed.push_back(k);
-    SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(
-        {priors[k].factor.get(), nullptr, priors[k].blocks, priors[k].manifolds}));
-    for (double* b : priors[k].blocks) {
-      if (b != T && std::find(others.begin(), others.end(), b) == others.end()) others.push_back(b);
+  // Its information in the prior moves onto the prior's other blocks.
+  if (prior.factor != nullptr && prior.Touches(T)) {
+    std::vector<double*> others;
+    for (double* b : prior.system.parameter_blocks) {
+      if (b != T) others.push_back(b);
     }
-  }
-  if (!others.empty()) {
-    MarginalizationPrior prior;
-    SWARMLIO_RETURN_IF_ERROR(marginalizer->Marginalize({T}, others, &prior));
-    SWARMLIO_RETURN_IF_ERROR(AddPrior(prior));
-  }
-  for (auto it = consumed.rbegin(); it != consumed.rend(); ++it) {
-    priors.erase(priors.begin() + static_cast<std::ptrdiff_t>(*it));
+    marginalizer->Clear();
+    SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(
+        {prior.factor.get(), nullptr, prior.system.parameter_blocks, prior.system.manifolds}));
+    MarginalizationPrior system;
+    SWARMLIO_RETURN_IF_ERROR(marginalizer->Marginalize({T}, others, &system));
+    SWARMLIO_RETURN_IF_ERROR(SetPrior(std::move(system)));
   }
   teammates.erase(std::remove_if(teammates.begin(), teammates.end(),
                                  [id](const std::unique_ptr<TeammateBlock>& t) { return t->id == id; }),
@@ -220,7 +286,7 @@ Status WindowSmoother::Impl::SyncTeammates(const SwarmState& x_pred, const Eigen
     const Eigen::MatrixXd C = P_pred.block(s.offset, s.offset, s.size, s.size);
     double* block = t->x.data();
     ordered.push_back(std::move(t));
-    SWARMLIO_RETURN_IF_ERROR(AddGaussianPrior({block}, {&teammate_manifold}, C));
+    SWARMLIO_RETURN_IF_ERROR(ExtendPrior(block, &teammate_manifold, C));
   }
   teammates = std::move(ordered);
   return Status::Ok();
@@ -229,21 +295,19 @@ Status WindowSmoother::Impl::SyncTeammates(const SwarmState& x_pred, const Eigen
 Status WindowSmoother::Impl::MarginalizeOldest(std::vector<LeavingScan>* leaving) {
   WindowScan& s0 = *scans[0];
   WindowScan& s1 = *scans[1];
+  if (prior.factor == nullptr || !prior.Touches(s0.ego.data())) {
+    return Status::Internal("window: the prior does not hold the oldest state");
+  }
   marginalizer->Clear();
-  std::vector<size_t> consumed;
   std::vector<double*> kept{s1.ego.data()};
   const auto keep = [&kept, &s0](double* b) {
     if (b != s0.ego.data() && std::find(kept.begin(), kept.end(), b) == kept.end()) {
       kept.push_back(b);
     }
   };
-  for (size_t k = 0; k < priors.size(); ++k) {
-    if (!priors[k].Touches(s0.ego.data())) continue;
-    consumed.push_back(k);
-    SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(
-        {priors[k].factor.get(), nullptr, priors[k].blocks, priors[k].manifolds}));
-    for (double* b : priors[k].blocks) keep(b);
-  }
+  SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(
+      {prior.factor.get(), nullptr, prior.system.parameter_blocks, prior.system.manifolds}));
+  for (double* b : prior.system.parameter_blocks) keep(b);
   if (s0.HasPlaneInformation()) {
     SWARMLIO_RETURN_IF_ERROR(
         marginalizer->AddResidualBlock({&s0.compressed, nullptr, {s0.ego.data()}, {&ego_manifold}}));
@@ -260,12 +324,12 @@ Status WindowSmoother::Impl::MarginalizeOldest(std::vector<LeavingScan>* leaving
     }
     SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(block));
   }
-  MarginalizationPrior prior;
-  SWARMLIO_RETURN_IF_ERROR(marginalizer->Marginalize({s0.ego.data()}, kept, &prior));
-  for (auto it = consumed.rbegin(); it != consumed.rend(); ++it) {
-    priors.erase(priors.begin() + static_cast<std::ptrdiff_t>(*it));
-  }
-  SWARMLIO_RETURN_IF_ERROR(AddPrior(prior));
+  MarginalizationPrior system;
+  SWARMLIO_RETURN_IF_ERROR(marginalizer->Marginalize({s0.ego.data()}, kept, &system));
+  // The teammate blocks random-walk over the interval [s0, s1] as in the
+  // filter (one shared block per teammate inside the window).
+  AddTeammateRandomWalk(s1.imu->SumOfSquaredSteps(), &system);
+  SWARMLIO_RETURN_IF_ERROR(SetPrior(std::move(system)));
   ++counters.marginalizations;
   Leave(&s0, leaving);
   scans.pop_front();
@@ -283,7 +347,7 @@ Status WindowSmoother::AddState(WindowStateInput input, std::vector<LeavingScan>
   if (!status.ok()) {
     for (auto& s : im.scans) im.Leave(s.get(), leaving);
     im.scans.clear();
-    im.priors.clear();
+    im.prior = Prior();
     im.teammates.clear();
   }
   *marginalize_s = SecondsSince(t0);

@@ -122,7 +122,9 @@ Status WindowSmoother::Impl::NewestCovariance(Eigen::MatrixXd* P) const {
     return AddBlockInformation(cost, blocks, manifolds, o, &H);
   };
   bool ok = true;
-  for (const Prior& p : priors) ok = ok && add(*p.factor, p.blocks, p.manifolds);
+  if (prior.factor != nullptr) {
+    ok = add(*prior.factor, prior.system.parameter_blocks, prior.system.manifolds);
+  }
   for (int i = 0; i < n; ++i) {
     const WindowScan& s = *scans[static_cast<size_t>(i)];
     double* ego = const_cast<double*>(s.ego.data());
@@ -182,7 +184,9 @@ WindowSolveResult WindowSmoother::Solve() {
   for (auto& t : im.teammates) {
     problem.AddParameterBlock(t->x.data(), GlobalExtrinsic::kAmbientSize, &im.teammate_manifold);
   }
-  for (const Prior& p : im.priors) problem.AddResidualBlock(p.factor.get(), nullptr, p.blocks);
+  if (im.prior.factor != nullptr) {
+    problem.AddResidualBlock(im.prior.factor.get(), nullptr, im.prior.system.parameter_blocks);
+  }
   for (size_t i = 1; i < im.scans.size(); ++i) {
     problem.AddResidualBlock(im.scans[i]->imu_factor.get(), nullptr, im.scans[i - 1]->ego.data(),
                              im.scans[i]->ego.data());

@@ -1,11 +1,12 @@
 // The state of the fixed-lag window smoother (src/lio/window_smoother.h):
-// its scans, teammate blocks and priors, shared by window_smoother.cc
+// its scans, teammate blocks and prior, shared by window_smoother.cc
 // (adding states, marginalization) and window_solve.cc (the solve and the
 // newest covariance). Internal to swarmlio_lio.
 #pragma once
 
 #include <ceres/manifold.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdint>
@@ -72,21 +73,23 @@ struct TeammateBlock {
   TeammateParameters x{};
 };
 
-// A prior over some blocks: the first state's (from the filter's prediction)
-// or a marginalization's.
+// The window's one prior, over the oldest ego state and every teammate block:
+// the first state's (from the filter's prediction), then each
+// marginalization's; a new teammate's block is appended to it.
 struct Prior {
+  MarginalizationPrior system;  // H*, b*, the blocks and their linearization points
   std::unique_ptr<MarginalizationPriorFactor> factor;
-  std::vector<double*> blocks;
-  std::vector<const ceres::Manifold*> manifolds;
 
   bool Touches(const double* block) const {
-    return std::find(blocks.begin(), blocks.end(), block) != blocks.end();
+    const auto& b = system.parameter_blocks;
+    return std::find(b.begin(), b.end(), block) != b.end();
   }
 };
 
 struct WindowSmoother::Impl {
   WindowOptions options;
   ImuPreintegrationOptions preintegration;
+  ProcessNoiseOptions process_noise;  // the propagator's (teammate random walks)
   AssociationOptions association;
   EsikfUpdateOptions update;
   const LocalMap* map = nullptr;
@@ -96,7 +99,7 @@ struct WindowSmoother::Impl {
   std::unique_ptr<Marginalizer> marginalizer;
   std::deque<std::unique_ptr<WindowScan>> scans;
   std::vector<std::unique_ptr<TeammateBlock>> teammates;  // the newest prediction's layout order
-  std::vector<Prior> priors;
+  Prior prior;  // factor == nullptr only while the window is empty
   std::unique_ptr<ImuPreintegration> interval;  // being integrated towards the next state
   bool interval_ok = false;
   WindowCounters counters;
@@ -107,10 +110,18 @@ struct WindowSmoother::Impl {
     }
     return nullptr;
   }
-  Status AddGaussianPrior(const std::vector<double*>& blocks,
+  Status SetPrior(MarginalizationPrior system);
+  // The prior N(current values, covariance) over `blocks`.
+  Status SetGaussianPrior(const std::vector<double*>& blocks,
                           const std::vector<const ceres::Manifold*>& manifolds,
                           const Eigen::MatrixXd& covariance);
-  Status AddPrior(const MarginalizationPrior& prior);
+  // Appends an independent block N(current value, covariance) to the prior.
+  Status ExtendPrior(double* block, const ceres::Manifold* manifold,
+                     const Eigen::MatrixXd& covariance);
+  // The teammates' random walk over an interval (the propagator's process
+  // noise, sum_dt2 = sum of the squared IMU steps) added to a prior's
+  // teammate blocks, in information form.
+  void AddTeammateRandomWalk(double sum_dt2, MarginalizationPrior* system) const;
   void Leave(WindowScan* scan, std::vector<LeavingScan>* leaving);
   Status Restart(WindowStateInput* input, std::vector<LeavingScan>* leaving);
   Status SyncTeammates(const SwarmState& x_pred, const Eigen::MatrixXd& P_pred);

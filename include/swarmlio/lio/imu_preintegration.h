@@ -120,6 +120,10 @@ class ImuPreintegration {
   bool initialized() const { return initialized_; }
   /// Integration steps of the current interval.
   int num_intervals() const { return static_cast<int>(steps_.size()); }
+  /// Sum of the squared step lengths of the current interval [s^2]: the
+  /// propagator's teammate random walk over the interval is this times the
+  /// teammate variances (docs/imu.md).
+  double SumOfSquaredSteps() const;
 
   int num_skipped_duplicate() const { return num_skipped_duplicate_; }
   int num_skipped_out_of_order() const { return num_skipped_out_of_order_; }
