@@ -166,12 +166,18 @@ WindowSolveResult WindowSmoother::Solve() {
   }
   const Clock::time_point t_build = Clock::now();
   im.ReintegrateImu();
-  std::vector<WindowScan*> active;
+  std::vector<WindowScan*> active;      // scans with point-to-plane terms
+  std::vector<WindowScan*> associated;  // of those, the ones re-associated at each iteration
   if (!im.map->empty()) {
     for (auto& s : im.scans) {
       if (!s->use_planes || s->in_map) continue;
-      s->associator->Reset(&s->points_in_b);  // the map changed since the last solve
       active.push_back(s.get());
+      // The older scans keep their correspondences (re-linearized) unless
+      // every scan is re-associated (window.reassociate_all_scans).
+      if (im.options.reassociate_all_scans || !s->updated || s.get() == im.scans.back().get()) {
+        s->associator->Reset(&s->points_in_b);  // the map changed since the last solve
+        associated.push_back(s.get());
+      }
     }
   }
   ceres::Problem::Options problem_options;
@@ -209,14 +215,14 @@ WindowSolveResult WindowSmoother::Solve() {
     solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
     for (int it = 0; it < im.options.max_iterations; ++it) {
       const Clock::time_point t_assoc = Clock::now();
-      for (WindowScan* s : active) {
+      for (WindowScan* s : associated) {
         SwarmState at;
         at.ego = s->State();
         result.status = s->associator->Associate(at, &s->correspondences);
         if (!result.status.ok()) break;
         s->stats = s->associator->stats();
-        s->RefreshPlanes();
       }
+      for (WindowScan* s : active) s->RefreshPlanes();
       result.association_s += SecondsSince(t_assoc);
       if (!result.status.ok()) break;
       const std::vector<double> start = im.Values();

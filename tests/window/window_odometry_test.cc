@@ -142,6 +142,11 @@ TEST(WindowOdometry, WindowOfOneReproducesTheFilter) {
     for (size_t k = 0; k < f.size(); ++k) {
       ASSERT_EQ(f[k].stamp_ns, w[k].stamp_ns);
       EXPECT_EQ(f[k].updated, w[k].updated) << "scan " << k;
+      // The map: the filter inserts scan k after its update, the window when
+      // it leaves, i.e. when scan k + 1 joins (before its association).
+      if (k > 0) {
+        EXPECT_EQ(w[k].map_size, f[k - 1].map_size) << "scan " << k;
+      }
       updated += w[k].updated ? 1 : 0;
       const double dp = (f[k].state.p_b_in_G - w[k].state.p_b_in_G).norm();
       const double dtheta_deg =
@@ -227,7 +232,8 @@ TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
       "  - name: a\n"
       "    bag: a.bag\n"
       "    sensor_preset: " + presets + "livox_mid360.yaml\n"
-      "    odometry: {estimator: window, window: {size: 7, linear_solver: sparse_normal_cholesky}}\n"
+      "    odometry: {estimator: window, window: {size: 7, linear_solver: sparse_normal_cholesky,\n"
+      "                                          reassociate_all_scans: false}}\n"
       "  - name: b\n"
       "    bag: b.bag\n"
       "    sensor_preset: " + presets + "livox_avia.yaml\n";
@@ -239,7 +245,9 @@ TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
   EXPECT_EQ(m.drones[0].odometry.window.size, 7);
   EXPECT_EQ(m.drones[0].odometry.window.linear_solver,
             lio::WindowLinearSolver::kSparseNormalCholesky);
+  EXPECT_FALSE(m.drones[0].odometry.window.reassociate_all_scans);
   EXPECT_EQ(m.drones[1].odometry.estimator, lio::EstimatorKind::kFilter);
+  EXPECT_TRUE(m.drones[1].odometry.window.reassociate_all_scans);
   const std::string bad =
       "drones:\n"
       "  - name: a\n"

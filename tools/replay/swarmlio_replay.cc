@@ -51,6 +51,9 @@ DEFINE_string(window_linear_solver, "",
               "linear solver of the window for every drone: dense_normal_cholesky | dense_qr | "
               "dense_schur | sparse_normal_cholesky; default: each drone's "
               "odometry.window.linear_solver");
+DEFINE_string(window_reassociate, "",
+              "all | newest: re-associate every scan of the window at each iteration, or only "
+              "the newest (default: each drone's odometry.window.reassociate_all_scans)");
 DEFINE_string(network_config, "",
               "YAML file with a `network:` section (latency, jitter, loss, reordering, "
               "duplication, seed; docs/network.md); default: the NetworkOptions defaults");
@@ -81,6 +84,12 @@ Status ApplyEstimatorFlags(replay::SwarmManifest* manifest) {
       return Status::InvalidArgument("--window_linear_solver=" + FLAGS_window_linear_solver +
                                      ": expected one of " +
                                      config::EnumChoices<lio::WindowLinearSolver>());
+    }
+    if (FLAGS_window_reassociate == "all" || FLAGS_window_reassociate == "newest") {
+      o.window.reassociate_all_scans = FLAGS_window_reassociate == "all";
+    } else if (!FLAGS_window_reassociate.empty()) {
+      return Status::InvalidArgument("--window_reassociate=" + FLAGS_window_reassociate +
+                                     ": expected all or newest");
     }
     if (const std::string invalid = o.Validate(); !invalid.empty()) {
       return Status::InvalidArgument(d.name + ": odometry." + invalid);

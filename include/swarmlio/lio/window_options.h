@@ -58,6 +58,11 @@ struct WindowOptions {
   /// (update.convergence_rotation_rad, update.convergence_translation_m),
   /// applied to every state of the window.
   int max_iterations = 4;
+  /// Re-associate every scan of the window against the map at each outer
+  /// iteration (true), or only the newest scan (false): the older ones keep
+  /// the correspondences of their last solve, re-linearized at the current
+  /// estimate (docs/window.md, "Re-association").
+  bool reassociate_all_scans = true;
   /// Linear solver of the Gauss-Newton step. DENSE_SCHUR was the fastest
   /// at K = 5 and 10 (docs/window.md, "Solver").
   WindowLinearSolver linear_solver = WindowLinearSolver::kDenseSchur;
@@ -82,6 +87,9 @@ struct WindowOptions {
     v("size", size, FieldSpec::InRange(1.0, 100.0, "scans", "K: scan states in the window"));
     v("max_iterations", max_iterations,
       FieldSpec::InRange(1.0, 100.0, "", "outer iterations (re-association + Gauss-Newton step)"));
+    v("reassociate_all_scans", reassociate_all_scans,
+      FieldSpec::Doc("re-associate every scan of the window at each iteration (false: only "
+                     "the newest; the others keep their correspondences)"));
     v("linear_solver", linear_solver,
       FieldSpec::Doc("Ceres linear solver of the Gauss-Newton step"));
     v("gravity_stddev_floor_m_s2", gravity_stddev_floor_m_s2,
