@@ -87,7 +87,7 @@ Eigen::Matrix<double, N, N> Regularized(const Eigen::Matrix<double, N, N>& C, do
 }
 
 // Mahalanobis distance^2 of h - z under S.
-double Mahalanobis2(const Eigen::Vector3d& e, const Eigen::Matrix3d& S) {
+inline double Mahalanobis2(const Eigen::Vector3d& e, const Eigen::Matrix3d& S) {
   return e.dot(S.ldlt().solve(e));
 }
 

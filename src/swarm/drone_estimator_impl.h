@@ -1,0 +1,69 @@
+// The state of one swarm::DroneEstimator, shared by its two translation
+// units: drone_estimator.cc (inputs, the scan's front end and its
+// observation terms) and drone_estimator_messages.cc (messages in, outputs
+// and messages out). Internal to src/swarm.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "dead_reckoning.h"
+#include "observation_terms.h"
+#include "swarmlio/lio/undistortion.h"
+#include "swarmlio/swarm/drone_estimator.h"
+#include "teammate_state.h"
+
+namespace swarmlio::swarm {
+namespace internal {
+
+inline double Seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
+
+// What OnScanDone records, joined with the odometry's output afterwards.
+struct SwarmPart {
+  std::vector<TeammateEstimate> teammates;
+  std::vector<IdentificationEvent> identifications;
+  std::vector<int> removed;
+  int active = 0;
+  int passive = 0;
+  int gravity = 0;
+  int rejected = 0;
+  int skipped_degenerate = 0;
+  bool frozen = false;
+  int detector_points = 0;
+};
+
+}  // namespace internal
+
+struct DroneEstimator::Impl {
+  std::map<int, internal::TeammateInfo> teammates;
+  std::map<int, internal::PendingMutual> mutual;  // by sender
+  int64_t last_extrinsic_broadcast_ns = 0;
+  bool broadcast_extrinsics_once = false;
+  std::deque<internal::PendingPassive> passive;
+  internal::MutualObservationModel model;
+  LidarScan selected;  // the raw points handed to the detector
+  std::vector<UndistortedPoint> undistorted;
+  std::vector<teammate::ScanPoint> points;
+  teammate::ScanResult detection;
+  double last_detection_stamp_s = 0.0;
+  double degenerate_average = 0.0;  // EMA of the own degeneracy flags
+  // Own dead-reckoned track: the propagated displacements within each scan
+  // chained across scans without the update's corrections, (stamp, s) [ns, m].
+  // s(t_j) - s(t_k) moves a passive observation's ego position from t_k back
+  // to t_j (docs/swarm.md section 8).
+  internal::DeadReckoningTrack dead_reckoning;
+  Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();
+  // The scan in flight (between OnFrontEnd and OnScanDone).
+  internal::SwarmPart part;
+  std::map<int, std::pair<int, int>> fused_by_teammate;  // active, passive
+  std::deque<internal::SwarmPart> parts;
+  std::vector<lio::ScanOutput> odometry_outputs;
+  std::vector<DroneOutput> outputs;
+  std::vector<net::SwarmMessage> messages;
+};
+
+}  // namespace swarmlio::swarm

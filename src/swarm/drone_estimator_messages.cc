@@ -1,0 +1,201 @@
+// swarm::DroneEstimator, the message side: what arrives from teammates, and
+// what leaves after each scan (the outputs, the own state and observations,
+// the own T_Gi_Gj estimates and gravity). The scan's front end is in
+// drone_estimator.cc; docs/swarm.md.
+#include <algorithm>
+#include <cmath>
+#include <variant>
+
+#include "drone_estimator_impl.h"
+
+namespace swarmlio::swarm {
+namespace {
+
+using internal::Finite;
+using internal::PendingMutual;
+using internal::PendingPassive;
+using internal::Predict;
+using internal::PredictedTeammate;
+using internal::Seconds;
+using internal::SwarmPart;
+using internal::TeammateInfo;
+
+}  // namespace
+
+Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
+  ++counters_.messages_received;
+  if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&received.message)) {
+    if (g->sender_id == self_id_ || g->sender_id < 0) {
+      ++counters_.messages_ignored;
+      return Status::Ok();
+    }
+    for (const net::GlobalExtrinsicEntry& e : g->entries) {
+      if (e.teammate_id != self_id_) continue;
+      if (!e.q_Gi_Gj.coeffs().allFinite() || !e.p_Gj_in_Gi.allFinite() ||
+          !e.covariance.allFinite()) {
+        continue;
+      }
+      impl_->mutual[g->sender_id] = PendingMutual{e};
+    }
+    // A zero vector: an old sender without gravity; ignored.
+    if (g->g_in_Gi.allFinite() && g->cov_g_in_Gi.allFinite() && g->g_in_Gi.norm() > 1.0) {
+      TeammateInfo& info = impl_->teammates[g->sender_id];
+      info.gravity_pending = true;
+      info.g_in_Gj = g->g_in_Gi;
+      info.cov_g_in_Gj = g->cov_g_in_Gi;
+    }
+    return Status::Ok();
+  }
+  const auto* m = std::get_if<net::EgoStateMessage>(&received.message);
+  if (m == nullptr || m->sender_id == self_id_ || m->sender_id < 0 || !Finite(*m)) {
+    ++counters_.messages_ignored;
+    return Status::Ok();
+  }
+  TeammateInfo& info = impl_->teammates[m->sender_id];
+  if (info.have_message && m->session_start_ns != info.session_start_ns) {
+    // j rebooted: its G_j is new. Its old track and trajectory are useless;
+    // its state block goes at the next scan; it is identified again.
+    ++counters_.teammate_restarts;
+    info.restarted = true;
+    info.have_message = false;
+    detector_->ForgetTeammate(m->sender_id);
+    impl_->mutual.erase(m->sender_id);
+    impl_->passive.erase(std::remove_if(impl_->passive.begin(), impl_->passive.end(),
+                                        [&](const PendingPassive& p) {
+                                          return p.from == m->sender_id;
+                                        }),
+                         impl_->passive.end());
+  }
+  if (info.have_message && m->stamp_ns <= info.last.stamp_ns) {
+    ++counters_.messages_ignored;  // older than what we have (reordered)
+  } else {
+    info.last = *m;
+    info.have_message = true;
+  }
+  info.session_start_ns = m->session_start_ns;
+  info.last_heard_ns = std::max(info.last_heard_ns, received.arrival_ns);
+
+  teammate::TeammateOdometry odometry;
+  odometry.stamp_s = Seconds(m->stamp_ns);
+  odometry.drone_id = m->sender_id;
+  odometry.p_bj_in_Gj = m->p_bj_in_Gj;
+  odometry.q_Gj_bj = m->q_Gj_bj.normalized();
+  odometry.v_bj_in_Gj = m->v_bj_in_Gj;
+  odometry.degenerate = m->degenerated;
+  detector_->AddTeammateOdometry(odometry);
+
+  for (const net::TeammateObservation& o : m->observations) {
+    if (o.observed_id != self_id_ || !o.p_bk_in_bj.allFinite() || !o.cov_p_bk_in_bj.allFinite()) {
+      continue;
+    }
+    PendingPassive p;
+    p.from = m->sender_id;
+    p.stamp_ns = m->stamp_ns;
+    p.p_bi_in_bj = o.p_bk_in_bj;
+    p.cov = o.cov_p_bk_in_bj;
+    p.sender = *m;
+    p.sender.observations.clear();
+    impl_->passive.push_back(std::move(p));
+  }
+  return Status::Ok();
+}
+
+void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState& x,
+                                const Eigen::MatrixXd& P) {
+  Impl& im = *impl_;
+  if (!output.hook_error.empty()) ++counters_.front_end_errors;
+  const int64_t t_k = output.stamp_ns;
+  for (int id : x.layout().teammate_ids()) {
+    TeammateEstimate e;
+    e.drone_id = id;
+    e.T_Gi_Gj = x.teammate(id);
+    const Segment block = x.layout().TeammateBlock(id);
+    e.extrinsic_covariance = P.block<6, 6>(block.offset, block.offset);
+    const TeammateInfo& info = im.teammates[id];
+    if (info.have_message &&
+        std::abs(Seconds(t_k - info.last.stamp_ns)) <= options_.swarm.max_message_age_s) {
+      const PredictedTeammate j = Predict(info.last, Seconds(t_k - info.last.stamp_ns));
+      const Eigen::Matrix3d R_Gi_Gj = e.T_Gi_Gj.R_Gi_Gj();
+      e.have_pose = true;
+      e.q_Gi_bj = Eigen::Quaterniond(R_Gi_Gj * j.R_Gj_bj).normalized();
+      e.p_bj_in_Gi = R_Gi_Gj * j.p_bj_in_Gj + e.T_Gi_Gj.p_Gj_in_Gi;
+      e.v_bj_in_Gi = R_Gi_Gj * j.v_bj_in_Gj;
+    }
+    e.seen = info.last_seen_ns == t_k;
+    const auto fused = im.fused_by_teammate.find(id);
+    if (fused != im.fused_by_teammate.end()) {
+      e.active_observations = fused->second.first;
+      e.passive_observations = fused->second.second;
+    }
+    im.part.teammates.push_back(e);
+  }
+  im.parts.push_back(std::move(im.part));
+  im.part = SwarmPart();
+
+  // The broadcast: this drone's state and what it saw of its teammates.
+  net::EgoStateMessage m;
+  m.sender_id = self_id_;
+  m.stamp_ns = t_k;
+  m.session_start_ns = odometry_->initialization().stamp_ns;
+  m.q_Gj_bj = x.ego.q_G_b.normalized();
+  m.p_bj_in_Gj = x.ego.p_b_in_G;
+  m.v_bj_in_Gj = x.ego.v_b_in_G;
+  m.omega_bj_in_bj = im.last_gyro - x.ego.gyro_bias;
+  const auto block = [&P](const Segment& s) {
+    return Eigen::Matrix3d(P.block<3, 3>(s.offset, s.offset));
+  };
+  m.cov_theta_Gj_bj = block(ErrorStateLayout::kRotation);
+  m.cov_p_bj_in_Gj = block(ErrorStateLayout::kPosition);
+  m.cov_v_bj_in_Gj = block(ErrorStateLayout::kVelocity);
+  m.degenerated = output.degenerate;
+  std::set<int> reported;
+  for (const teammate::TeammateObservation& o : im.detection.observations) {
+    if (static_cast<int>(m.observations.size()) >= net::EgoStateMessage::kMaxObservations) break;
+    if (o.drone_id == self_id_ || !reported.insert(o.drone_id).second) continue;
+    net::TeammateObservation n;
+    n.observed_id = o.drone_id;
+    n.p_bk_in_bj = o.p_bj_in_bi;
+    n.cov_p_bk_in_bj = o.covariance_m2;
+    m.observations.push_back(n);
+  }
+  im.detection.observations.clear();
+  if (m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite()) im.messages.push_back(m);
+
+  // The own T_Gi_Gj estimates, every extrinsic_broadcast_period_s and right
+  // after a new identification (teammates use them to identify this drone).
+  const double period = options_.swarm.extrinsic_broadcast_period_s;
+  const bool new_block = !im.parts.back().identifications.empty();
+  if (period > 0.0 && x.layout().NumTeammates() > 0 &&
+      (new_block || !im.broadcast_extrinsics_once ||
+       Seconds(t_k - im.last_extrinsic_broadcast_ns) >= period)) {
+    std::vector<net::GlobalExtrinsicEntry> entries;
+    for (int id : x.layout().teammate_ids()) {
+      net::GlobalExtrinsicEntry e;
+      e.teammate_id = id;
+      e.source = net::ExtrinsicSource::kTrajectoryMatch;
+      e.q_Gi_Gj = x.teammate(id).q_Gi_Gj.normalized();
+      e.p_Gj_in_Gi = x.teammate(id).p_Gj_in_Gi;
+      const Segment b = x.layout().TeammateBlock(id);
+      e.covariance = P.block<6, 6>(b.offset, b.offset);
+      e.covariance = 0.5 * (e.covariance + e.covariance.transpose()).eval();
+      if (e.q_Gi_Gj.coeffs().allFinite() && e.p_Gj_in_Gi.allFinite() && e.covariance.allFinite()) {
+        entries.push_back(e);
+      }
+    }
+    const Segment gravity = ErrorStateLayout::kGravity;
+    Eigen::Matrix3d cov_g = P.block<3, 3>(gravity.offset, gravity.offset);
+    cov_g = 0.5 * (cov_g + cov_g.transpose()).eval();
+    const Eigen::Vector3d g = x.ego.g_in_G.allFinite() && cov_g.allFinite()
+                                  ? x.ego.g_in_G
+                                  : Eigen::Vector3d::Zero();
+    if (!cov_g.allFinite()) cov_g.setZero();
+    for (net::GlobalExtrinsicMessage& g_msg :
+         net::SplitGlobalExtrinsics(self_id_, t_k, entries, g, cov_g)) {
+      im.messages.push_back(std::move(g_msg));
+    }
+    im.last_extrinsic_broadcast_ns = t_k;
+    im.broadcast_extrinsics_once = true;
+  }
+}
+
+}  // namespace swarmlio::swarm
