@@ -220,21 +220,12 @@ Status ImuPreintegration::IntegrateTo(int64_t stamp_ns, const ImuSample* next_sa
   return Status::Ok();
 }
 
-// Exactly ImuPropagator::MidpointInput (same operations, same rounding).
+// The propagator's interpolation (the same function: same rounding).
 ImuInput ImuPreintegration::MidpointInput(const ImuInput& next,
                                           int64_t next_stamp_ns,
                                           int64_t end_ns) const {
-  const double span_s = StampSeconds(next_stamp_ns - last_sample_stamp_ns_);
-  const double t_mid_s = 0.5 * (StampSeconds(stamp_ns_ - last_sample_stamp_ns_) +
-                                StampSeconds(end_ns - last_sample_stamp_ns_));
-  const double alpha = span_s > 0.0 ? t_mid_s / span_s : 0.0;
-  ImuInput mid;
-  mid.angular_velocity_rad_s =
-      last_input_.angular_velocity_rad_s +
-      alpha * (next.angular_velocity_rad_s - last_input_.angular_velocity_rad_s);
-  mid.specific_force_m_s2 = last_input_.specific_force_m_s2 +
-                            alpha * (next.specific_force_m_s2 - last_input_.specific_force_m_s2);
-  return mid;
+  return swarmlio::MidpointInput(last_input_, last_sample_stamp_ns_, next, next_stamp_ns, stamp_ns_,
+                                 end_ns);
 }
 
 }  // namespace swarmlio

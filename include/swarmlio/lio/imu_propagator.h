@@ -60,6 +60,13 @@ struct ImuInput {
 /// (the signed factor from ImuInitialization).
 ImuInput ToImuInput(const ImuSample& sample, double acceleration_to_m_s2);
 
+/// The input held over [from_ns, to_ns]: the linear interpolation between the
+/// last sample (`last` at `last_stamp_ns`) and `next` (at `next_stamp_ns`),
+/// taken at the interval's midpoint (the propagator's discrete model; the
+/// preintegration uses the same function so the two agree to round-off).
+ImuInput MidpointInput(const ImuInput& last, int64_t last_stamp_ns, const ImuInput& next,
+                       int64_t next_stamp_ns, int64_t from_ns, int64_t to_ns);
+
 /// One step of the discrete model above (ego part) with noise w.
 EgoState PropagateEgo(const EgoState& x,
                       const ImuInput& u,
