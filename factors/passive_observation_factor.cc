@@ -21,12 +21,16 @@ PassiveObservationFactor::PassiveObservationFactor(const Eigen::Vector3d& p_bi_i
                                                    const Eigen::Matrix3d& Sigma_p_bj_in_Gj,
                                                    const EgoState& ego_lin,
                                                    const GlobalExtrinsic& extrinsic_lin,
-                                                   const Eigen::Vector3d& displacement_to_tj)
+                                                   const ImuRetrodiction& retrodiction)
     : p_bi_in_bj_(p_bi_in_bj),
       dt_(dt),
-      displacement_to_tj_(displacement_to_tj),
+      W_(retrodiction.weight_s2),
+      accel_bias_lin_(ego_lin.accel_bias),
       R_Gj_bj_(R_Gj_bj),
       p_bj_in_Gj_(p_bj_in_Gj) {
+  const Eigen::Matrix3d R0_T = ego_lin.R_G_b().transpose();
+  u_ = R0_T * (retrodiction.weighted_acc_in_G - W_ * ego_lin.g_in_G);
+  M_ = R0_T * retrodiction.weighted_R_G_b;
   const Eigen::Matrix3d h0_hat = so3::Hat(Predict(ego_lin, extrinsic_lin));
   const Eigen::Matrix3d S = Sigma_obs + h0_hat * Sigma_theta_bj * h0_hat.transpose() +
                             R_Gj_bj_.transpose() * Sigma_p_bj_in_Gj * R_Gj_bj_;
@@ -34,10 +38,15 @@ PassiveObservationFactor::PassiveObservationFactor(const Eigen::Vector3d& p_bi_i
   sqrt_information_ = observation_factor::SqrtInformation(covariance_, "passive observation");
 }
 
+Eigen::Vector3d PassiveObservationFactor::C(const EgoState& ego) const {
+  return u_ + M_ * (accel_bias_lin_ - ego.accel_bias);
+}
+
 Eigen::Vector3d PassiveObservationFactor::EgoPositionInGj(const EgoState& ego,
                                                           const GlobalExtrinsic& extrinsic) const {
+  const Eigen::Vector3d A = ego.R_G_b() * C(ego) + W_ * ego.g_in_G;
   return RotationOf(extrinsic.q_Gi_Gj).transpose() *
-         (ego.p_b_in_G + ego.v_b_in_G * dt_ + displacement_to_tj_ - extrinsic.p_Gj_in_Gi);
+         (ego.p_b_in_G + ego.v_b_in_G * dt_ + A - extrinsic.p_Gj_in_Gi);
 }
 
 Eigen::Vector3d PassiveObservationFactor::Predict(const EgoState& ego,
@@ -61,6 +70,10 @@ void PassiveObservationFactor::TangentJacobian(
     J_ego->setZero();
     J_ego->block<3, 3>(0, ErrorStateLayout::kPosition.offset) = W_M;
     J_ego->block<3, 3>(0, ErrorStateLayout::kVelocity.offset) = W_M * dt_;
+    const Eigen::Matrix3d R = ego.R_G_b();
+    J_ego->block<3, 3>(0, ErrorStateLayout::kRotation.offset) = -W_M * R * so3::Hat(C(ego));
+    J_ego->block<3, 3>(0, ErrorStateLayout::kAccelBias.offset) = -W_M * R * M_;
+    J_ego->block<3, 3>(0, ErrorStateLayout::kGravity.offset) = W_M * W_;
   }
   if (J_ext != nullptr) {
     J_ext->block<3, 3>(0, ErrorStateLayout::kTeammateRotationOffset) =

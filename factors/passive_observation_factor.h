@@ -7,14 +7,23 @@
 // Constants: the measurement z = p_bi_in_bj (in b_j [m]) taken by j at time
 // t_j (already in i's clock), the teammate's broadcast pose at t_j
 // (R_Gj_bj, p_bj_in_Gj), dt = t_j - t_k [s] where t_k is the time of the
-// ego state, and a constant displacement d [m] in G_i. The ego position is
-// moved to t_j with its velocity (constant-velocity time compensation), or by
-// d, the own dead-reckoned displacement from t_k back to t_j (the caller then
-// passes dt = 0); dt = 0 and d = 0 switch it off:
+// ego state, and the IMU retrodiction (W, u, M) of the own motion over
+// [t_j, t_k] (ImuRetrodiction below; all zero: constant velocity). The ego
+// position at t_j is a function of the state at t_k:
 //
-//   w = R_Gi_Gj^T (p_bi_in_Gi + v_bi_in_Gi dt + d - p_Gj_in_Gi)  (ego position in G_j)
+//   p(t_j) = p + v dt + A,   A = R (u + M (b_a0 - b_a)) + W g
+//   w = R_Gi_Gj^T (p(t_j) - p_Gj_in_Gi)                    (ego position at t_j in G_j)
 //   h = R_Gj_bj^T (w - p_bj_in_Gj)
 //   r = U^-1 (h - z),   S = U U^T (lower Cholesky),   |r|^2 = (h - z)^T S^-1 (h - z)
+//
+// A is the double integral of the kinematic acceleration R(s)(f(s) - b_a) + g
+// from t_j to t_k with weight (s - t_j): W = int (s - t_j) ds = dt^2 / 2,
+// u = R0^T (int (s - t_j) a(s) ds - W g0) and M = R0^T int (s - t_j) R(s) ds,
+// formed at the linearization state (R0, b_a0, g0); at that state A equals
+// the integrated propagated acceleration. Through A the observation of the
+// past position also informs attitude, accelerometer bias and gravity (a
+// delayed observation modelled with p and v only fed the bias's effect into
+// the velocity and diverged beyond 0.3 s of latency; docs/swarm.md).
 //
 // Noise, evaluated ONCE at construction at the linearization point (the ego
 // state and extrinsic given to the constructor, through h0 = h(lin)):
@@ -26,13 +35,15 @@
 //
 // Tangent Jacobian of h (right perturbation R Exp(dtheta), p + dp; ego in
 // ErrorStateLayout order [dtheta dp dv dbg dba dg], extrinsic [dphi dp]),
-// with M = R_Gj_bj^T R_Gi_Gj^T:
-//   dh/d dtheta_ego = 0
-//   dh/d dp_ego     = M
-//   dh/d dv_ego     = M dt
+// with M_h = R_Gj_bj^T R_Gi_Gj^T and c = u + M (b_a0 - b_a):
+//   dh/d dtheta_ego = -M_h R [c]x           (R Exp(e) c = R c - R [c]x e)
+//   dh/d dp_ego     = M_h
+//   dh/d dv_ego     = M_h dt
+//   dh/d dbg_ego    = 0
+//   dh/d dba_ego    = -M_h R M
+//   dh/d dg_ego     = M_h W
 //   dh/d dphi_ext   = R_Gj_bj^T [w]x        ((R Exp(f))^T u = (I - [f]x) R^T u)
-//   dh/d dp_ext     = -M
-//   zero for b_g, b_a, g.
+//   dh/d dp_ext     = -M_h
 // The residual Jacobian is U^-1 times these. Rotation columns are lifted to
 // the quaternions' ambient coordinates with SO3Manifold::LiftTangentJacobian.
 #pragma once
@@ -44,6 +55,15 @@
 #include "swarmlio/state/swarm_state.h"
 
 namespace swarmlio {
+
+/// The own IMU motion over [t_j, t_k] in G_i, integrals with the weight
+/// (s - t_j) (from the propagated poses; src/swarm/dead_reckoning.h). All
+/// zero: no history (the factor then moves the ego with constant velocity).
+struct ImuRetrodiction {
+  double weight_s2 = 0.0;                                         // W = int (s - t_j) ds [s^2]
+  Eigen::Vector3d weighted_acc_in_G = Eigen::Vector3d::Zero();    // int (s - t_j) a(s) ds [m]
+  Eigen::Matrix3d weighted_R_G_b = Eigen::Matrix3d::Zero();       // int (s - t_j) R_G_b(s) ds [s^2]
+};
 
 class PassiveObservationFactor final
     : public ceres::SizedCostFunction<3, EgoState::kAmbientSize, GlobalExtrinsic::kAmbientSize> {
@@ -61,7 +81,7 @@ class PassiveObservationFactor final
                            const Eigen::Matrix3d& Sigma_p_bj_in_Gj,
                            const EgoState& ego_lin,
                            const GlobalExtrinsic& extrinsic_lin,
-                           const Eigen::Vector3d& displacement_to_tj = Eigen::Vector3d::Zero());
+                           const ImuRetrodiction& retrodiction = ImuRetrodiction());
 
   bool Evaluate(double const* const* parameters,
                 double* residuals,
@@ -86,12 +106,17 @@ class PassiveObservationFactor final
   const Eigen::Matrix3d& sqrt_information() const { return sqrt_information_; }
 
  private:
-  // w = R_Gi_Gj^T (p_bi_in_Gi + v dt + d - p_Gj_in_Gi), the ego position at t_j in G_j.
+  // c = u + M (b_a0 - b_a) and A = R c + W g.
+  Eigen::Vector3d C(const EgoState& ego) const;
+  // w = R_Gi_Gj^T (p + v dt + A - p_Gj_in_Gi), the ego position at t_j in G_j.
   Eigen::Vector3d EgoPositionInGj(const EgoState& ego, const GlobalExtrinsic& extrinsic) const;
 
   Eigen::Vector3d p_bi_in_bj_;
   double dt_;
-  Eigen::Vector3d displacement_to_tj_;
+  double W_;            // [s^2]
+  Eigen::Vector3d u_;   // [m]
+  Eigen::Matrix3d M_;   // [s^2]
+  Eigen::Vector3d accel_bias_lin_;
   Eigen::Matrix3d R_Gj_bj_;
   Eigen::Vector3d p_bj_in_Gj_;
   Eigen::Matrix3d covariance_;

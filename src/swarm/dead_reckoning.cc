@@ -5,39 +5,52 @@
 namespace swarmlio::swarm::internal {
 
 void DeadReckoningTrack::Append(const std::vector<ImuPose>& poses, double keep_s) {
-  if (poses.empty()) return;
-  if (track_.empty() || track_.back().first > poses.front().stamp_ns) {
-    track_.clear();  // first scan, or time went back (a new log): start over
-    track_.emplace_back(poses.front().stamp_ns, Eigen::Vector3d::Zero());
+  if (poses.size() < 2) return;
+  // Time going back (a new log) or a gap of more than 50 ms (dropped scans):
+  // start over, so the history stays contiguous; a shorter gap is bridged
+  // with the first new acceleration.
+  if (!segments_.empty()) {
+    const int64_t gap_ns = poses.front().stamp_ns - segments_.back().end_ns;
+    if (gap_ns < 0 || gap_ns > 50'000'000) {
+      segments_.clear();
+    } else if (gap_ns > 0) {
+      segments_.push_back({segments_.back().end_ns, poses.front().stamp_ns,
+                           poses.front().acc_in_G_m_s2, poses.front().R_G_b});
+    }
   }
-  for (size_t k = 1; k < poses.size(); ++k) {
-    if (poses[k].stamp_ns <= track_.back().first) continue;
-    track_.emplace_back(poses[k].stamp_ns,
-                        track_.back().second + poses[k].p_b_in_G - poses[k - 1].p_b_in_G);
+  for (size_t k = 0; k + 1 < poses.size(); ++k) {
+    if (poses[k + 1].stamp_ns <= poses[k].stamp_ns) continue;
+    segments_.push_back(
+        {poses[k].stamp_ns, poses[k + 1].stamp_ns, poses[k].acc_in_G_m_s2, poses[k].R_G_b});
   }
+  if (segments_.empty()) return;
   const int64_t keep_ns = static_cast<int64_t>(keep_s * 1e9);
-  const int64_t newest = track_.back().first;
-  while (track_.size() > 2 && track_[1].first < newest - keep_ns) track_.pop_front();
+  const int64_t newest = segments_.back().end_ns;
+  while (segments_.size() > 1 && segments_.front().end_ns < newest - keep_ns) {
+    segments_.pop_front();
+  }
 }
 
-Eigen::Vector3d DeadReckoningTrack::At(int64_t t_ns) const {
-  const auto it = std::lower_bound(
-      track_.begin(), track_.end(), t_ns,
-      [](const std::pair<int64_t, Eigen::Vector3d>& e, int64_t t) { return e.first < t; });
-  if (it == track_.begin()) return it->second;
-  const auto& b = *it;
-  const auto& a = *(it - 1);
-  const double u = static_cast<double>(t_ns - a.first) / static_cast<double>(b.first - a.first);
-  return a.second + u * (b.second - a.second);
-}
-
-bool DeadReckoningTrack::Displacement(int64_t t_j_ns, int64_t t_k_ns,
-                                      Eigen::Vector3d* displacement) const {
-  if (track_.size() < 2 || t_j_ns > t_k_ns || t_j_ns < track_.front().first ||
-      t_k_ns > track_.back().first) {
+bool DeadReckoningTrack::Retrodiction(int64_t t_j_ns, int64_t t_k_ns,
+                                      ImuRetrodiction* r) const {
+  if (segments_.empty() || t_j_ns > t_k_ns || t_j_ns < segments_.front().begin_ns ||
+      t_k_ns > segments_.back().end_ns) {
     return false;
   }
-  *displacement = At(t_j_ns) - At(t_k_ns);
+  // First segment ending after t_j.
+  auto it = std::upper_bound(segments_.begin(), segments_.end(), t_j_ns,
+                             [](int64_t t, const Segment& s) { return t < s.end_ns; });
+  ImuRetrodiction sum;
+  for (; it != segments_.end() && it->begin_ns < t_k_ns; ++it) {
+    // int_a^b (s - t_j) ds over the part of the segment inside [t_j, t_k].
+    const double a = 1e-9 * static_cast<double>(std::max(it->begin_ns, t_j_ns) - t_j_ns);
+    const double b = 1e-9 * static_cast<double>(std::min(it->end_ns, t_k_ns) - t_j_ns);
+    const double w = 0.5 * (b * b - a * a);
+    sum.weight_s2 += w;
+    sum.weighted_acc_in_G += w * it->acc_in_G;
+    sum.weighted_R_G_b += w * it->R_G_b;
+  }
+  *r = sum;
   return true;
 }
 

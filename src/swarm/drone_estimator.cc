@@ -349,19 +349,16 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
         continue;
       }
       const GlobalExtrinsic& T = x->teammate(p.from);
-      // Own position at t_j: the dead-reckoned displacement d when the track
-      // covers t_j, else the constant-velocity shift v dt. (Measured on the
-      // wall-facing Avia: d beats v dt, d with the velocity column kept
-      // (p + v dt + (d - v_hat dt)) and d with dt^2 Sigma_v as noise; docs/swarm.md.)
-      Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
+      // Own position at t_j: p + v dt + A(R, b_a, g) with A the IMU part of
+      // the motion (dead_reckoning.h) when the history covers t_j, else the
+      // constant-velocity shift p + v dt.
+      ImuRetrodiction retrodiction;
       const Eigen::Matrix3d Sigma_obs = Regularized<3>(p.cov);
-      const bool reckoned =
-          so.time_compensation && im.dead_reckoning.Displacement(p.stamp_ns, t_k, &displacement);
+      if (so.time_compensation) im.dead_reckoning.Retrodiction(p.stamp_ns, t_k, &retrodiction);
       auto factor = std::make_unique<PassiveObservationFactor>(
-          p.p_bi_in_bj, so.time_compensation && !reckoned ? dt : 0.0,
-          p.sender.q_Gj_bj.normalized().toRotationMatrix(), p.sender.p_bj_in_Gj, Sigma_obs,
-          Regularized<3>(p.sender.cov_theta_Gj_bj, 1e-10), Regularized<3>(p.sender.cov_p_bj_in_Gj),
-          x->ego, T, displacement);
+          p.p_bi_in_bj, so.time_compensation ? dt : 0.0, p.sender.q_Gj_bj.normalized().toRotationMatrix(),
+          p.sender.p_bj_in_Gj, Sigma_obs, Regularized<3>(p.sender.cov_theta_Gj_bj, 1e-10),
+          Regularized<3>(p.sender.cov_p_bj_in_Gj), x->ego, T, retrodiction);
       const Eigen::Vector3d e = factor->Predict(x->ego, T) - p.p_bi_in_bj;
       const Eigen::Matrix3d S = factor->covariance();
       if (add(std::move(factor), p.from, e, S)) {

@@ -51,10 +51,9 @@ struct DroneEstimator::Impl {
   teammate::ScanResult detection;
   double last_detection_stamp_s = 0.0;
   double degenerate_average = 0.0;  // EMA of the own degeneracy flags
-  // Own dead-reckoned track: the propagated displacements within each scan
-  // chained across scans without the update's corrections, (stamp, s) [ns, m].
-  // s(t_j) - s(t_k) moves a passive observation's ego position from t_k back
-  // to t_j (docs/swarm.md section 8).
+  // Own propagated accelerations of the last seconds: their double integral
+  // moves a passive observation's ego position from t_k back to t_j together
+  // with the state's velocity (dead_reckoning.h, docs/swarm.md section 8).
   internal::DeadReckoningTrack dead_reckoning;
   Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();
   // The scan in flight (between OnFrontEnd and OnScanDone).

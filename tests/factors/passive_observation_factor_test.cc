@@ -1,6 +1,6 @@
 // PassiveObservationFactor: a teammate observed the ego at t_j = t_k + dt.
 // Checks the prediction against its definition (with and without time
-// compensation), the whitening against an independently built S, the
+// compensation, with the IMU retrodiction A(R, b_a, g)), the whitening against an independently built S, the
 // analytic manifold Jacobians (random, near-identity and near-pi rotations,
 // nonzero dt) and that the check rejects flipped columns, and TangentJacobian
 // against the stated formulas and numeric differentiation.
@@ -68,14 +68,26 @@ class Sampler {
   std::normal_distribution<double> n_;
 };
 
+// The IMU part of the ego's motion back to t_j, written from its definition:
+// A = R (u + M (b_a0 - b_a)) + W g with u, M formed at the linearization
+// state `lin` (R0, b_a0, g0).
+Eigen::Vector3d RetrodictedA(const EgoState& ego, const ImuRetrodiction& r, const EgoState& lin) {
+  const Eigen::Matrix3d R0_T = lin.R_G_b().transpose();
+  const Eigen::Vector3d u = R0_T * (r.weighted_acc_in_G - r.weight_s2 * lin.g_in_G);
+  const Eigen::Matrix3d M = R0_T * r.weighted_R_G_b;
+  return ego.R_G_b() * (u + M * (lin.accel_bias - ego.accel_bias)) + r.weight_s2 * ego.g_in_G;
+}
+
 // The definition, written independently of the factor.
 Eigen::Vector3d PassivePrediction(const EgoState& ego,
                                   const GlobalExtrinsic& T,
                                   double dt,
                                   const Eigen::Matrix3d& R_Gj_bj,
                                   const Eigen::Vector3d& p_bj_in_Gj,
-                                  const Eigen::Vector3d& d = Eigen::Vector3d::Zero()) {
-  const Eigen::Vector3d p_bi_in_Gi_at_tj = ego.p_b_in_G + ego.v_b_in_G * dt + d;
+                                  const ImuRetrodiction& r = ImuRetrodiction(),
+                                  const EgoState& lin = EgoState()) {
+  const Eigen::Vector3d p_bi_in_Gi_at_tj =
+      ego.p_b_in_G + ego.v_b_in_G * dt + RetrodictedA(ego, r, lin);
   const Eigen::Vector3d p_bi_in_Gj = T.R_Gi_Gj().transpose() * (p_bi_in_Gi_at_tj - T.p_Gj_in_Gi);
   return R_Gj_bj.transpose() * (p_bi_in_Gj - p_bj_in_Gj);
 }
@@ -86,7 +98,7 @@ struct Problem {
   EgoState ego;
   GlobalExtrinsic extrinsic;
   double dt;
-  Eigen::Vector3d d;  // constant displacement to t_j (the dead-reckoned alternative to v dt)
+  ImuRetrodiction r;  // the IMU part of the motion back to t_j (W = dt^2 / 2)
   Eigen::Matrix3d R_Gj_bj;
   Eigen::Vector3d p_bj_in_Gj;
   Eigen::Vector3d z;
@@ -101,25 +113,29 @@ struct Problem {
           double dt_s,
           bool exact_measurement)
       : ego(s->Ego(ego_angle)), extrinsic(s->Extrinsic(extrinsic_angle)), dt(dt_s) {
-    d = s->Gaussian3(0.05);
+    ego_lin = ego.BoxPlus(s->Gaussian(18, 0.02));
+    extrinsic_lin = extrinsic.BoxPlus(s->Gaussian(6, 0.02));
+    // A plausible history: W = dt^2 / 2, the attitude over it near the
+    // current one, a few m/s^2 of acceleration.
+    r.weight_s2 = 0.5 * dt * dt;
+    r.weighted_acc_in_G = r.weight_s2 * s->Gaussian3(3.0);
+    r.weighted_R_G_b = r.weight_s2 * (ego.R_G_b() * so3::Exp(s->Gaussian3(0.05)));
     R_Gj_bj = s->Rotation(teammate_angle).toRotationMatrix();
     p_bj_in_Gj = s->Gaussian3(8.0);
-    z = PassivePrediction(ego, extrinsic, dt, R_Gj_bj, p_bj_in_Gj, d);
+    z = PassivePrediction(ego, extrinsic, dt, R_Gj_bj, p_bj_in_Gj, r, ego_lin);
     if (!exact_measurement) z += s->Gaussian3(0.3);
     Sigma_obs = s->Covariance(0.1, 1e-3);
     Sigma_theta = s->Covariance(0.01, 1e-6);
     Sigma_p = s->Covariance(0.1, 1e-3);
-    ego_lin = ego.BoxPlus(s->Gaussian(18, 0.02));
-    extrinsic_lin = extrinsic.BoxPlus(s->Gaussian(6, 0.02));
   }
   PassiveObservationFactor Factor() const {
     return PassiveObservationFactor(z, dt, R_Gj_bj, p_bj_in_Gj, Sigma_obs, Sigma_theta, Sigma_p,
-                                    ego_lin, extrinsic_lin, d);
+                                    ego_lin, extrinsic_lin, r);
   }
   // S written out from its definition, at h0 = h(ego_lin, extrinsic_lin).
   Eigen::Matrix3d S() const {
     const Eigen::Matrix3d H =
-        so3::Hat(PassivePrediction(ego_lin, extrinsic_lin, dt, R_Gj_bj, p_bj_in_Gj, d));
+        so3::Hat(PassivePrediction(ego_lin, extrinsic_lin, dt, R_Gj_bj, p_bj_in_Gj, r, ego_lin));
     return Sigma_obs + H * Sigma_theta * H.transpose() + R_Gj_bj.transpose() * Sigma_p * R_Gj_bj;
   }
 };
@@ -173,24 +189,31 @@ TEST(PassiveObservationFactor, TimeCompensationMovesTheEgoByItsVelocity) {
   Sampler s(3);
   const Problem pr(&s, -1.0, -1.0, -1.0, 0.08, true);
   const PassiveObservationFactor factor = pr.Factor();
-  // With dt (and the displacement d), the prediction equals the dt = 0, d = 0
-  // prediction of the ego moved by v dt + d.
+  // With dt (and the retrodiction A), the prediction equals the dt = 0, A = 0
+  // prediction of the ego moved by v dt + A.
   EgoState moved = pr.ego;
-  moved.p_b_in_G += pr.ego.v_b_in_G * 0.08 + pr.d;
+  moved.p_b_in_G += pr.ego.v_b_in_G * 0.08 + RetrodictedA(pr.ego, pr.r, pr.ego_lin);
   const PassiveObservationFactor no_compensation(pr.z, 0.0, pr.R_Gj_bj, pr.p_bj_in_Gj, pr.Sigma_obs,
                                                  pr.Sigma_theta, pr.Sigma_p, pr.ego_lin,
                                                  pr.extrinsic_lin);
   EXPECT_NEAR(
       (factor.Predict(pr.ego, pr.extrinsic) - no_compensation.Predict(moved, pr.extrinsic)).norm(),
       0.0, 1e-12);
-  // dt = 0: the velocity does not enter (zero velocity columns).
-  EgoState other_velocity = pr.ego;
-  other_velocity.v_b_in_G = s.Gaussian3(3.0);
+  // dt = 0, no history: velocity, attitude, accelerometer bias and gravity
+  // do not enter (zero columns).
+  EgoState other = pr.ego;
+  other.v_b_in_G = s.Gaussian3(3.0);
+  other.q_G_b = s.Rotation(-1.0);
+  other.accel_bias = s.Gaussian3(0.5);
+  other.g_in_G = s.Gaussian3(9.0);
   EXPECT_EQ(no_compensation.Predict(pr.ego, pr.extrinsic),
-            no_compensation.Predict(other_velocity, pr.extrinsic));
+            no_compensation.Predict(other, pr.extrinsic));
   Eigen::Matrix<double, 3, 18> J_ego;
   no_compensation.TangentJacobian(pr.ego, pr.extrinsic, &J_ego, nullptr);
   EXPECT_EQ(J_ego.middleCols<3>(ErrorStateLayout::kVelocity.offset).norm(), 0.0);
+  EXPECT_EQ(J_ego.middleCols<3>(ErrorStateLayout::kRotation.offset).norm(), 0.0);
+  EXPECT_EQ(J_ego.middleCols<3>(ErrorStateLayout::kAccelBias.offset).norm(), 0.0);
+  EXPECT_EQ(J_ego.middleCols<3>(ErrorStateLayout::kGravity.offset).norm(), 0.0);
 }
 
 TEST(PassiveObservationFactor, PredictionMatchesTheDefinition) {
@@ -200,7 +223,7 @@ TEST(PassiveObservationFactor, PredictionMatchesTheDefinition) {
     const EgoState other_ego = s.Ego(-1.0);
     const GlobalExtrinsic other_ext = s.Extrinsic(-1.0);
     EXPECT_NEAR((pr.Factor().Predict(other_ego, other_ext) -
-                 PassivePrediction(other_ego, other_ext, pr.dt, pr.R_Gj_bj, pr.p_bj_in_Gj, pr.d))
+                 PassivePrediction(other_ego, other_ext, pr.dt, pr.R_Gj_bj, pr.p_bj_in_Gj, pr.r, pr.ego_lin))
                     .norm(),
                 0.0, 1e-10);
   }
@@ -215,7 +238,7 @@ TEST(PassiveObservationFactor, WhitenedResidualIsTheMahalanobisDistance) {
     const GlobalExtrinsic ext = s.Extrinsic(-1.0);
     const Blocks b(ego, ext);
     const Eigen::Vector3d r = EvaluateResidual(factor, b);
-    const Eigen::Vector3d e = PassivePrediction(ego, ext, pr.dt, pr.R_Gj_bj, pr.p_bj_in_Gj, pr.d) - pr.z;
+    const Eigen::Vector3d e = PassivePrediction(ego, ext, pr.dt, pr.R_Gj_bj, pr.p_bj_in_Gj, pr.r, pr.ego_lin) - pr.z;
     const Eigen::Matrix3d S = pr.S();
     const double mahalanobis = e.dot(S.ldlt().solve(e));
     EXPECT_NEAR(r.squaredNorm(), mahalanobis, 1e-9 * mahalanobis);
@@ -251,9 +274,10 @@ TEST(PassiveObservationFactor, FlippedColumnsAreRejected) {
   const PassiveObservationFactor factor = pr.Factor();
   const Blocks b(pr.ego, pr.extrinsic);
   ASSERT_TRUE(testing::CostFunctionJacobiansAreCorrect(factor, b.manifolds(), b.pointers()));
-  // The ego attitude does not enter h: its quaternion columns are zero, so
-  // flipping them changes nothing; position, velocity and both extrinsic
-  // parts must be rejected.
+  // The gyro bias does not enter h: its columns are zero, so flipping them
+  // changes nothing; attitude (through the retrodiction), position,
+  // velocity, accelerometer bias, gravity and both extrinsic parts must be
+  // rejected.
   std::array<double, 3 * 19> j_ego;
   std::array<double, 3 * 7> j_ext;
   Eigen::Vector3d r;
@@ -261,8 +285,15 @@ TEST(PassiveObservationFactor, FlippedColumnsAreRejected) {
   const std::vector<const double*> p = b.pointers();
   ASSERT_TRUE(factor.Evaluate(p.data(), r.data(), jacobians));
   for (int row = 0; row < 3; ++row) {
-    for (int col = 0; col < 4; ++col) EXPECT_EQ(j_ego[row * 19 + col], 0.0);
+    for (int col = 10; col < 13; ++col) EXPECT_EQ(j_ego[row * 19 + col], 0.0);
   }
+  const testing::FlippedJacobianColumns ego_attitude(&factor, /*block=*/0, /*num_columns=*/4);
+  const testing::FlippedJacobianColumns ego_accel_bias(&factor, 0, 3, 13);
+  const testing::FlippedJacobianColumns ego_gravity(&factor, 0, 3, 16);
+  EXPECT_FALSE(testing::CostFunctionJacobiansAreCorrect(ego_attitude, b.manifolds(), b.pointers()));
+  EXPECT_FALSE(
+      testing::CostFunctionJacobiansAreCorrect(ego_accel_bias, b.manifolds(), b.pointers()));
+  EXPECT_FALSE(testing::CostFunctionJacobiansAreCorrect(ego_gravity, b.manifolds(), b.pointers()));
   const testing::FlippedJacobianColumns ego_position(&factor, /*block=*/0, /*num_columns=*/3,
                                                      /*first_column=*/4);
   const testing::FlippedJacobianColumns ego_velocity(&factor, 0, 3, 7);
@@ -286,10 +317,21 @@ TEST(PassiveObservationFactor, TangentJacobianIsTheStatedFormula) {
     const Eigen::Matrix3d R_e = pr.extrinsic.R_Gi_Gj();
     const Eigen::Matrix3d M = pr.R_Gj_bj.transpose() * R_e.transpose();
     const Eigen::Vector3d w =
-        R_e.transpose() * (pr.ego.p_b_in_G + pr.ego.v_b_in_G * pr.dt + pr.d - pr.extrinsic.p_Gj_in_Gi);
+        R_e.transpose() * (pr.ego.p_b_in_G + pr.ego.v_b_in_G * pr.dt +
+                           RetrodictedA(pr.ego, pr.r, pr.ego_lin) - pr.extrinsic.p_Gj_in_Gi);
+    // c = u + M_r (b_a0 - b_a), with u and M_r formed at ego_lin.
+    const Eigen::Matrix3d R0_T = pr.ego_lin.R_G_b().transpose();
+    const Eigen::Matrix3d M_r = R0_T * pr.r.weighted_R_G_b;
+    const Eigen::Vector3d c =
+        R0_T * (pr.r.weighted_acc_in_G - pr.r.weight_s2 * pr.ego_lin.g_in_G) +
+        M_r * (pr.ego_lin.accel_bias - pr.ego.accel_bias);
+    const Eigen::Matrix3d R = pr.ego.R_G_b();
     Eigen::Matrix<double, 3, 18> H_ego = Eigen::Matrix<double, 3, 18>::Zero();
+    H_ego.block<3, 3>(0, 0) = -M * R * so3::Hat(c);
     H_ego.block<3, 3>(0, 3) = M;
     H_ego.block<3, 3>(0, 6) = M * pr.dt;
+    H_ego.block<3, 3>(0, 12) = -M * R * M_r;
+    H_ego.block<3, 3>(0, 15) = M * pr.r.weight_s2;
     Eigen::Matrix<double, 3, 6> H_ext;
     H_ext.leftCols<3>() = pr.R_Gj_bj.transpose() * so3::Hat(w);
     H_ext.rightCols<3>() = -M;
