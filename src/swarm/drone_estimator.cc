@@ -23,6 +23,7 @@
 namespace swarmlio::swarm {
 namespace {
 
+using internal::ComposeExtrinsic;
 using internal::FixedExtrinsicCost;
 using internal::Predict;
 using internal::PredictedTeammate;
@@ -215,6 +216,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
     x->AddTeammate(id.drone_id, T);
     AppendCovarianceBlock(C, P);
     im.teammates[id.drone_id].last_seen_ns = t_k;
+    im.teammates[id.drone_id].via_graph = false;
     IdentificationEvent event;
     event.drone_id = id.drone_id;
     event.stamp_ns = t_k;
@@ -243,6 +245,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       x->AddTeammate(j, T);
       AppendCovarianceBlock(C, P);
       im.teammates[j].last_seen_ns = t_k;
+      im.teammates[j].via_graph = false;
       IdentificationEvent event;
       event.drone_id = j;
       event.stamp_ns = t_k;
@@ -253,6 +256,11 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
     }
   }
   im.mutual.clear();
+  // Identification through teammates: k, identified by a known teammate j
+  // (its own match T_Gj_Gk), enters as T_Gi_Gj T_Gj_Gk with the covariance
+  // and the cross-covariances it inherits from the T_Gi_Gj block (it is a
+  // function of it). Among several such j, the smallest composed covariance.
+  if (so.graph_identification) AddTeammatesThroughTeammates(t_k, x, P);
   for (const teammate::TeammateObservation& o : im.detection.observations) {
     im.teammates[o.drone_id].last_seen_ns = t_k;
   }
@@ -398,4 +406,67 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
   }
   return Status::Ok();
 }
+void DroneEstimator::AddTeammatesThroughTeammates(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P) {
+  Impl& im = *impl_;
+  const SwarmOptions& so = options_.swarm;
+  struct Candidate {
+    GlobalExtrinsic T;
+    Eigen::Matrix<double, 6, 6> J_ij;
+    Eigen::Matrix<double, 6, 6> C;  // J_ij P_ij J_ij^T + J_jk C_jk J_jk^T
+    int via = -1;
+  };
+  std::map<int, Candidate> best;  // by k
+  for (int j : x->layout().teammate_ids()) {
+    const TeammateInfo& info_j = im.teammates[j];
+    if (info_j.via_graph) continue;  // only first-hand edges of first-hand teammates
+    const Segment bj = x->layout().TeammateBlock(j);
+    const Eigen::Matrix<double, 6, 6> P_ij = P->block<6, 6>(bj.offset, bj.offset);
+    for (const auto& [k, e] : info_j.identified) {
+      if (k == self_id_ || x->HasTeammate(k)) continue;
+      const auto it_k = im.teammates.find(k);
+      if (it_k != im.teammates.end() && it_k->second.restarted) continue;
+      GlobalExtrinsic T_jk;
+      T_jk.q_Gi_Gj = e.q_Gi_Gj.normalized();
+      T_jk.p_Gj_in_Gi = e.p_Gj_in_Gi;
+      Candidate c;
+      Eigen::Matrix<double, 6, 6> J_jk;
+      ComposeExtrinsic(x->teammate(j), T_jk, &c.T, &c.J_ij, &J_jk);
+      const Eigen::Matrix<double, 6, 6> C_jk = Regularized<6>(e.covariance, 1e-10);
+      c.C = c.J_ij * P_ij * c.J_ij.transpose() + J_jk * C_jk * J_jk.transpose();
+      c.via = j;
+      const auto it = best.find(k);
+      if (it == best.end() || c.C.trace() < it->second.C.trace()) best[k] = c;
+    }
+  }
+  for (const auto& [k, c] : best) {
+    if (!detector_->AddIdentifiedTeammate(k, Seconds(t_k), c.T.R_Gi_Gj(), c.T.p_Gj_in_Gi)) continue;
+    // Cross-covariances: d(T_ik) = J_ij d(T_ij) + J_jk d(T_jk) with d(T_jk)
+    // independent of this drone's state, so P(k, :) = J_ij P(j, :).
+    const int n = static_cast<int>(P->rows());
+    const Segment bj = x->layout().TeammateBlock(c.via);
+    const Eigen::MatrixXd cross = c.J_ij * P->middleRows(bj.offset, 6);
+    Eigen::Matrix<double, 6, 6> C = 0.5 * (c.C + c.C.transpose());
+    for (int d = 0; d < 3; ++d) {
+      C(d, d) = std::max(C(d, d), so.init_rotation_sigma_floor_rad * so.init_rotation_sigma_floor_rad);
+      C(3 + d, 3 + d) =
+          std::max(C(3 + d, 3 + d), so.init_translation_sigma_floor_m * so.init_translation_sigma_floor_m);
+    }
+    x->AddTeammate(k, c.T);
+    AppendCovarianceBlock(C, P);
+    P->block(n, 0, 6, n) = cross;
+    P->block(0, n, n, 6) = cross.transpose();
+    TeammateInfo& info = im.teammates[k];
+    info.last_seen_ns = t_k;
+    info.via_graph = true;
+    IdentificationEvent event;
+    event.drone_id = k;
+    event.stamp_ns = t_k;
+    event.method = "graph";
+    event.via_drone_id = c.via;
+    event.initial_T_Gi_Gj = c.T;
+    im.part.identifications.push_back(event);
+    ++counters_.identifications;
+  }
+}
+
 }  // namespace swarmlio::swarm

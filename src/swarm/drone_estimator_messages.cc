@@ -30,12 +30,15 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
       return Status::Ok();
     }
     for (const net::GlobalExtrinsicEntry& e : g->entries) {
-      if (e.teammate_id != self_id_) continue;
       if (!e.q_Gi_Gj.coeffs().allFinite() || !e.p_Gj_in_Gi.allFinite() ||
-          !e.covariance.allFinite()) {
+          !e.covariance.allFinite() || e.teammate_id < 0) {
         continue;
       }
-      impl_->mutual[g->sender_id] = PendingMutual{e};
+      if (e.teammate_id == self_id_) {
+        impl_->mutual[g->sender_id] = PendingMutual{e};
+      } else if (e.source == net::ExtrinsicSource::kTrajectoryMatch) {
+        impl_->teammates[g->sender_id].identified[e.teammate_id] = e;
+      }
     }
     // A zero vector: an old sender without gravity; ignored.
     if (g->g_in_Gi.allFinite() && g->cov_g_in_Gi.allFinite() && g->g_in_Gi.norm() > 1.0) {
@@ -58,6 +61,7 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
     ++counters_.teammate_restarts;
     info.restarted = true;
     info.have_message = false;
+    info.identified.clear();  // its T_Gj_Gk were in its old G_j
     detector_->ForgetTeammate(m->sender_id);
     impl_->mutual.erase(m->sender_id);
     impl_->passive.erase(std::remove_if(impl_->passive.begin(), impl_->passive.end(),
@@ -172,7 +176,8 @@ void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState&
     for (int id : x.layout().teammate_ids()) {
       net::GlobalExtrinsicEntry e;
       e.teammate_id = id;
-      e.source = net::ExtrinsicSource::kTrajectoryMatch;
+      e.source = im.teammates[id].via_graph ? net::ExtrinsicSource::kGraph
+                                            : net::ExtrinsicSource::kTrajectoryMatch;
       e.q_Gi_Gj = x.teammate(id).q_Gi_Gj.normalized();
       e.p_Gj_in_Gi = x.teammate(id).p_Gj_in_Gi;
       const Segment b = x.layout().TeammateBlock(id);

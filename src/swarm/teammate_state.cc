@@ -21,6 +21,21 @@ PredictedTeammate Predict(const net::EgoStateMessage& m, double dt) {
   return out;
 }
 
+void ComposeExtrinsic(const GlobalExtrinsic& T_ij, const GlobalExtrinsic& T_jk, GlobalExtrinsic* T_ik,
+                      Eigen::Matrix<double, 6, 6>* J_ij, Eigen::Matrix<double, 6, 6>* J_jk) {
+  const Eigen::Matrix3d R_ij = T_ij.R_Gi_Gj();
+  const Eigen::Matrix3d R_jk = T_jk.R_Gi_Gj();
+  T_ik->q_Gi_Gj = (T_ij.q_Gi_Gj.normalized() * T_jk.q_Gi_Gj.normalized()).normalized();
+  T_ik->p_Gj_in_Gi = R_ij * T_jk.p_Gj_in_Gi + T_ij.p_Gj_in_Gi;
+  J_ij->setZero();
+  J_ij->topLeftCorner<3, 3>() = R_jk.transpose();
+  J_ij->bottomLeftCorner<3, 3>() = -R_ij * so3::Hat(T_jk.p_Gj_in_Gi);
+  J_ij->bottomRightCorner<3, 3>().setIdentity();
+  J_jk->setZero();
+  J_jk->topLeftCorner<3, 3>().setIdentity();
+  J_jk->bottomRightCorner<3, 3>() = R_ij;
+}
+
 void InvertExtrinsic(const net::GlobalExtrinsicEntry& e, GlobalExtrinsic* T,
                      Eigen::Matrix<double, 6, 6>* C) {
   const Eigen::Matrix3d R = e.q_Gi_Gj.normalized().toRotationMatrix();

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 
 #include "swarmlio/net/messages.h"
 #include "swarmlio/state/swarm_state.h"
@@ -23,6 +24,10 @@ struct TeammateInfo {
   int64_t last_heard_ns = 0;       // arrival of the newest message (own clock)
   int64_t last_seen_ns = 0;        // last LiDAR observation (own clock)
   bool restarted = false;          // session_start changed: drop its block
+  bool via_graph = false;          // its block came through a teammate's T_Gj_Gk
+  // j's own trajectory matches T_Gj_Gk, by k (from its GlobalExtrinsic
+  // broadcasts; kTrajectoryMatch entries only, so derived edges never chain).
+  std::map<int, net::GlobalExtrinsicEntry> identified;
   // j's gravity in G_j from its newest GlobalExtrinsic message, fused once.
   bool gravity_pending = false;
   Eigen::Vector3d g_in_Gj = Eigen::Vector3d::Zero();
@@ -41,6 +46,14 @@ struct PredictedTeammate {
 /// j's broadcast state moved by dt [s] with its velocity and angular rate
 /// (covariance: position + dt^2 velocity).
 PredictedTeammate Predict(const net::EgoStateMessage& m, double dt);
+
+/// T_Gi_Gk = T_Gi_Gj T_Gj_Gk and the Jacobians of its error [dphi; dp]
+/// (R = R^ Exp(dphi), p = p^ + dp) with respect to the errors of T_Gi_Gj
+/// (J_ij) and of T_Gj_Gk (J_jk):
+///   dphi_ik = R_jk^T dphi_ij + dphi_jk
+///   dp_ik   = dp_ij - R_ij [p_Gk_in_Gj]x dphi_ij + R_ij dp_jk
+void ComposeExtrinsic(const GlobalExtrinsic& T_ij, const GlobalExtrinsic& T_jk, GlobalExtrinsic* T_ik,
+                      Eigen::Matrix<double, 6, 6>* J_ij, Eigen::Matrix<double, 6, 6>* J_jk);
 
 struct PendingPassive {
   int from = -1;

@@ -126,7 +126,14 @@ class ObserverSink : public sim::DroneSink {
       if (std::holds_alternative<net::EgoStateMessage>(m)) ++ego_states_sent;
       if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&m)) {
         ++extrinsic_messages_sent;
-        for (const net::GlobalExtrinsicEntry& e : g->entries) EXPECT_EQ(e.teammate_id, teammate_);
+        for (const net::GlobalExtrinsicEntry& e : g->entries) {
+          if (e.teammate_id == relayed_id) {
+            ++graph_entries_sent;
+            EXPECT_EQ(e.source, net::ExtrinsicSource::kGraph);  // never relayed as first-hand
+          } else {
+            EXPECT_EQ(e.teammate_id, teammate_);
+          }
+        }
       }
     }
   }
@@ -139,6 +146,8 @@ class ObserverSink : public sim::DroneSink {
   double mutual_at_s = 1e9;   // from then on the teammate sends its T_Gj_Gi (it identified us)
   int indefinite_every_k = 0;  // every k-th broadcast has indefinite covariances (0: none)
   int gravity_messages_delivered = 0;  // GlobalExtrinsic messages with the teammate's gravity
+  int relayed_id = -1;  // with mutual_at_s: the teammate also sends its own match of this drone
+  int graph_entries_sent = 0;  // the observer's broadcasts of relayed_id
 
  private:
   // Broadcasts of the teammate that arrived (20 ms after its scan end) by `now_ns`.
@@ -179,6 +188,23 @@ class ObserverSink : public sim::DroneSink {
       r.arrival_ns = sim_.StampNs(observer_, t + latency_s);
       r.message = m;
       EXPECT_TRUE(estimator_->AddMessage(r).ok());
+      if (relayed_id >= 0) {
+        // The relayed drone broadcasts its state too (no observations).
+        const sim::KinematicState sk =
+            sim_.drones()[static_cast<size_t>(relayed_id)].trajectory.StateAt(t);
+        const Eigen::Isometry3d T_Gk_W = ToIsometry(sim_.T_W_G(relayed_id)).inverse();
+        net::EgoStateMessage mk = m;
+        mk.sender_id = relayed_id;
+        mk.session_start_ns = 1;
+        mk.q_Gj_bj = Eigen::Quaterniond(T_Gk_W.linear() * sk.R_W_b).normalized();
+        mk.p_bj_in_Gj = T_Gk_W * sk.p_b_in_W;
+        mk.v_bj_in_Gj = T_Gk_W.linear() * sk.v_b_in_W;
+        mk.omega_bj_in_bj = sk.omega_b;
+        mk.observations.clear();
+        net::ReceivedMessage rk = r;
+        rk.message = mk;
+        EXPECT_TRUE(estimator_->AddMessage(rk).ok());
+      }
       if (t >= mutual_at_s) {
         // The teammate's estimate of T_Gj_Gi: the truth, 1 cm / 0.2 deg sigma.
         const Eigen::Isometry3d T_Gj_Gi = T_Gj_W_ * ToIsometry(sim_.T_W_G(observer_));
@@ -191,6 +217,15 @@ class ObserverSink : public sim::DroneSink {
         e.p_Gj_in_Gi = T_Gj_Gi.translation();
         e.covariance.diagonal() << 1.2e-5, 1.2e-5, 1.2e-5, 1e-4, 1e-4, 1e-4;
         g.entries.push_back(e);
+        if (relayed_id >= 0) {
+          // And its own trajectory match of drone k: the truth, same sigma.
+          const Eigen::Isometry3d T_Gj_Gk = T_Gj_W_ * ToIsometry(sim_.T_W_G(relayed_id));
+          net::GlobalExtrinsicEntry ek = e;
+          ek.teammate_id = relayed_id;
+          ek.q_Gi_Gj = Eigen::Quaterniond(T_Gj_Gk.linear()).normalized();
+          ek.p_Gj_in_Gi = T_Gj_Gk.translation();
+          g.entries.push_back(ek);
+        }
         // Its gravity in G_j (the simulator's W has z up).
         g.g_in_Gi = T_Gj_W_.linear() * Eigen::Vector3d(0.0, 0.0, -kGravity);
         g.cov_g_in_Gi = 1e-4 * Eigen::Matrix3d::Identity();
@@ -361,6 +396,58 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
   const Eigen::Isometry3d T_true =
       ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
   EXPECT_LT((last.teammates[0].T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm(), 0.03);
+}
+
+// Identification through teammates: teammate 1 identifies the observer (its
+// T_G1_G0) and drone 2 (its own match T_G1_G2) from 10 s on; drone 2 never
+// sends anything and the observer never matches it. The observer adds 1 by
+// the mutual identification and 2 through 1 in the same scan, with
+// T_G0_G2 = T_G0_G1 T_G1_G2 near the truth, a covariance at least the
+// composed one, and broadcasts it as derived (kGraph), never as its own match.
+TEST(DroneEstimator, AddsATeammateThroughAnIdentifiedTeammate) {
+  sim::Scenario scenario = IndoorScenario();
+  ASSERT_GE(scenario.drones.size(), 3u);
+  const int observer = 0, teammate = 1, relayed = 2;
+  ObserverRun run(std::move(scenario), 12.0, observer, teammate);
+  ObserverSink& sink = *run.sink;
+  const sim::Simulator& simulator = *run.simulator;
+  sink.mutual_at_s = 10.0;
+  sink.relayed_id = relayed;
+  ASSERT_TRUE(run.Run());
+
+  int64_t mutual_ns = -1, graph_ns = -1;
+  int via = -1;
+  for (const DroneOutput& o : sink.outputs) {
+    for (const IdentificationEvent& e : o.identifications) {
+      if (e.drone_id == teammate && e.method == "teammate_match") mutual_ns = e.stamp_ns;
+      if (e.drone_id == relayed) {
+        EXPECT_EQ(e.method, "graph");
+        graph_ns = e.stamp_ns;
+        via = e.via_drone_id;
+      }
+    }
+  }
+  ASSERT_GE(mutual_ns, 0);
+  ASSERT_GE(graph_ns, 0) << "drone 2 never added";
+  EXPECT_EQ(graph_ns, mutual_ns);
+  EXPECT_EQ(via, teammate);
+  EXPECT_GT(sink.graph_entries_sent, 0);
+  const DroneOutput& last = sink.outputs.back();
+  ASSERT_EQ(last.teammates.size(), 2u);
+  for (const TeammateEstimate& t : last.teammates) {
+    SCOPED_TRACE(t.drone_id);
+    const Eigen::Isometry3d T_true = ToIsometry(simulator.T_W_G(observer)).inverse() *
+                                     ToIsometry(simulator.T_W_G(t.drone_id));
+    EXPECT_LT((t.T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm(), 0.03);
+    const double angle =
+        Eigen::AngleAxisd(t.T_Gi_Gj.R_Gi_Gj().transpose() * T_true.linear()).angle();
+    EXPECT_LT(angle, 0.5 * M_PI / 180.0);
+    // At least the relayed entry's own uncertainty (1 cm): composing cannot
+    // make it more certain than its parts.
+    if (t.drone_id == relayed) {
+      EXPECT_GT(t.extrinsic_covariance(3, 3), 0.9e-4);
+    }
+  }
 }
 
 }  // namespace

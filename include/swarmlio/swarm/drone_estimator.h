@@ -63,7 +63,9 @@ struct TeammateEstimate {
 struct IdentificationEvent {
   int drone_id = -1;
   int64_t stamp_ns = 0;       // own clock
-  std::string method;         // "trajectory_match"
+  std::string method;         // "trajectory_match", "teammate_match" (it identified me) or
+                              // "graph" (through teammate via_drone_id's own match)
+  int via_drone_id = -1;      // "graph": the teammate whose T_Gj_Gk was composed
   double mean_residual_m = 0.0;
   GlobalExtrinsic initial_T_Gi_Gj;
 };
@@ -135,6 +137,10 @@ class DroneEstimator : public lio::ScanStageHooks {
   // trackers of the last scan (predicted to t_k).
   void SelectDetectorPoints(const LidarScan& raw, int64_t t_k, const SwarmState& x,
                             const Eigen::Matrix3d& R_imu_lidar, LidarScan* selected) const;
+
+  // Identification through teammates (docs/swarm.md): adds every k that a
+  // first-hand teammate j identified and this drone has not.
+  void AddTeammatesThroughTeammates(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P);
 
   int self_id_;
   DroneEstimatorOptions options_;

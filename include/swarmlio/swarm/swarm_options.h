@@ -73,6 +73,10 @@ struct SwarmOptions {
   /// added here with the inverse, without waiting for an own match
   /// (docs/swarm.md "Mutual identification").
   bool mutual_identification = true;
+  /// A teammate k that a known teammate j identified itself (its broadcast
+  /// T_Gj_Gk from a trajectory match) is added through T_Gi_Gj T_Gj_Gk
+  /// without an own match (docs/swarm.md "Identification through teammates").
+  bool graph_identification = true;
   /// The own T_Gi_Gj estimates are broadcast this often (0 = never) [s].
   double extrinsic_broadcast_period_s = 1.0;
   /// Radius of the ball around each tracked object kept out of the map [m].
@@ -106,6 +110,8 @@ struct SwarmOptions {
       FieldSpec::Doc("do not fuse observations involving a teammate that reports degeneracy"));
     v("mutual_identification", mutual_identification,
       FieldSpec::Doc("add a teammate that identified this drone, with the inverse of its T_Gj_Gi"));
+    v("graph_identification", graph_identification,
+      FieldSpec::Doc("add a teammate that a known teammate identified, through its T_Gj_Gk"));
     v("extrinsic_broadcast_period_s", extrinsic_broadcast_period_s,
       FieldSpec::AtLeast(0.0, "s", "broadcast the own T_Gi_Gj estimates this often (0 = never)"));
     v("map_exclusion_radius_m", map_exclusion_radius_m,

@@ -1,0 +1,81 @@
+// The extrinsic composition of identification through teammates
+// (src/swarm/teammate_state.h): T_Gi_Gk = T_Gi_Gj T_Gj_Gk and its error
+// Jacobians, checked against numeric differentiation on the manifold at
+// random, near-identity and near-pi rotations; a flipped block is caught.
+#include "src/swarm/teammate_state.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "swarmlio/math/so3.h"
+
+namespace swarmlio::swarm::internal {
+namespace {
+
+GlobalExtrinsic RandomExtrinsic(std::mt19937* rng, double angle) {
+  std::normal_distribution<double> n;
+  const Eigen::Vector3d axis = Eigen::Vector3d(n(*rng), n(*rng), n(*rng)).normalized();
+  GlobalExtrinsic T;
+  T.q_Gi_Gj = so3::ExpQuaternion(axis * angle);
+  T.p_Gj_in_Gi = 5.0 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+  return T;
+}
+
+// d(T_ik)/d(dx) by central differences, dx applied to T_ij (first) or T_jk.
+Eigen::Matrix<double, 6, 6> Numeric(const GlobalExtrinsic& T_ij, const GlobalExtrinsic& T_jk,
+                                    bool first) {
+  GlobalExtrinsic T_ik;
+  Eigen::Matrix<double, 6, 6> J1, J2;
+  ComposeExtrinsic(T_ij, T_jk, &T_ik, &J1, &J2);
+  Eigen::Matrix<double, 6, 6> J;
+  const double h = 1e-6;
+  for (int c = 0; c < 6; ++c) {
+    Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+    d[c] = h;
+    GlobalExtrinsic plus, minus;
+    ComposeExtrinsic(first ? T_ij.BoxPlus(d) : T_ij, first ? T_jk : T_jk.BoxPlus(d), &plus, &J1, &J2);
+    ComposeExtrinsic(first ? T_ij.BoxPlus(-d) : T_ij, first ? T_jk : T_jk.BoxPlus(-d), &minus, &J1,
+                     &J2);
+    J.col(c) = (plus.BoxMinus(T_ik) - minus.BoxMinus(T_ik)) / (2.0 * h);
+  }
+  return J;
+}
+
+TEST(ComposeExtrinsic, ComposesAndItsJacobiansMatchNumericDifferentiation) {
+  std::mt19937 rng(3);
+  for (const double angle : {0.7, 2.5, 1e-9, M_PI - 1e-4}) {
+    SCOPED_TRACE(angle);
+    for (int trial = 0; trial < 5; ++trial) {
+      const GlobalExtrinsic T_ij = RandomExtrinsic(&rng, angle);
+      const GlobalExtrinsic T_jk = RandomExtrinsic(&rng, 1.3);
+      GlobalExtrinsic T_ik;
+      Eigen::Matrix<double, 6, 6> J_ij, J_jk;
+      ComposeExtrinsic(T_ij, T_jk, &T_ik, &J_ij, &J_jk);
+      // The composition itself: a point of G_k mapped to G_i both ways.
+      const Eigen::Vector3d x_in_Gk(0.3, -1.2, 2.0);
+      EXPECT_LT((T_ik.T_Gi_Gj() * x_in_Gk - T_ij.T_Gi_Gj() * (T_jk.T_Gi_Gj() * x_in_Gk)).norm(), 1e-12);
+      EXPECT_LT((J_ij - Numeric(T_ij, T_jk, true)).norm(), 1e-6);
+      EXPECT_LT((J_jk - Numeric(T_ij, T_jk, false)).norm(), 1e-6);
+    }
+  }
+}
+
+TEST(ComposeExtrinsic, AFlippedBlockIsCaught) {
+  std::mt19937 rng(4);
+  const GlobalExtrinsic T_ij = RandomExtrinsic(&rng, 0.9);
+  const GlobalExtrinsic T_jk = RandomExtrinsic(&rng, 1.1);
+  GlobalExtrinsic T_ik;
+  Eigen::Matrix<double, 6, 6> J_ij, J_jk;
+  ComposeExtrinsic(T_ij, T_jk, &T_ik, &J_ij, &J_jk);
+  const Eigen::Matrix<double, 6, 6> numeric = Numeric(T_ij, T_jk, true);
+  Eigen::Matrix<double, 6, 6> flipped = J_ij;
+  flipped.bottomLeftCorner<3, 3>() *= -1.0;  // the lever-arm term's sign
+  EXPECT_GT((flipped - numeric).norm(), 1e-2);
+  flipped = J_ij;
+  flipped.topLeftCorner<3, 3>() *= -1.0;
+  EXPECT_GT((flipped - numeric).norm(), 1e-2);
+}
+
+}  // namespace
+}  // namespace swarmlio::swarm::internal
