@@ -245,7 +245,8 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       x->AddTeammate(j, T);
       AppendCovarianceBlock(C, P);
       im.teammates[j].last_seen_ns = t_k;
-      im.teammates[j].via_graph = false;
+      // The inverse of an edge j derived itself stays derived: never composed.
+      im.teammates[j].via_graph = pending.entry.source == net::ExtrinsicSource::kGraph;
       IdentificationEvent event;
       event.drone_id = j;
       event.stamp_ns = t_k;
