@@ -3,15 +3,24 @@
 #
 #   tools/swarmlio.sh setup   install the Debian packages (idempotent) and build in Release
 #   tools/swarmlio.sh demo    setup, then run the main job on the built-in default scenario
-#   tools/swarmlio.sh test    setup, run all tests; then build with ASan+UBSan and run them again
+#   tools/swarmlio.sh test    setup, run all tests; then build with ASan+UBSan and run them again;
+#                             then fuzz the packet decoder (clang, libFuzzer) and run the threaded
+#                             tests under ThreadSanitizer (docs/network.md, "Fuzzing and sanitizers in CI")
+#   tools/swarmlio.sh fuzz    only the fuzz stage;  tools/swarmlio.sh tsan   only the TSan stage
 #
 # Environment: BUILD_DIR (default build), ASAN_BUILD_DIR (default build-asan),
+# FUZZ_BUILD_DIR (default build-fuzz), TSAN_BUILD_DIR (default build-tsan),
+# FUZZ_RUNS (default 1000000), FUZZ_MAX_TIME_S (default 300),
 # JOBS (default 2), CI=true turns warnings into errors.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
 ASAN_BUILD_DIR="${ASAN_BUILD_DIR:-$ROOT/build-asan}"
+FUZZ_BUILD_DIR="${FUZZ_BUILD_DIR:-$ROOT/build-fuzz}"
+TSAN_BUILD_DIR="${TSAN_BUILD_DIR:-$ROOT/build-tsan}"
+FUZZ_RUNS="${FUZZ_RUNS:-1000000}"
+FUZZ_MAX_TIME_S="${FUZZ_MAX_TIME_S:-300}"
 JOBS="${JOBS:-2}"
 WERROR=OFF
 if [[ "${CI:-}" == "true" ]]; then WERROR=ON; fi
@@ -25,6 +34,10 @@ PACKAGES=(
   libcairo2-dev
   libsodium-dev
 )
+# The fuzz stage needs clang and its libFuzzer/sanitizer runtimes.
+case "${1:-}" in
+  test|fuzz) PACKAGES+=(clang libclang-rt-14-dev) ;;
+esac
 
 log() { printf '\033[1m[swarmlio]\033[0m %s\n' "$*" >&2; }
 
@@ -62,6 +75,72 @@ setup() {
   configure_and_build "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release
 }
 
+# configure_and_build_targets DIR "TARGET..." [extra cmake args...]: only those
+# targets and their dependencies.
+configure_and_build_targets() {
+  local dir="$1" targets="$2"; shift 2
+  local launcher=()
+  if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+  cmake -S "$ROOT" -B "$dir" -DSWARMLIO_WERROR="$WERROR" "${launcher[@]}" "$@" >/dev/null
+  log "building $targets in $dir"
+  # shellcheck disable=SC2086  # a list of target names
+  cmake --build "$dir" -j"$JOBS" --target $targets
+}
+
+# The packet decoder under libFuzzer + ASan + UBSan: FUZZ_RUNS inputs from a
+# fresh corpus grown from generated seeds. A crash, a sanitizer report, a
+# timeout or fewer than FUZZ_RUNS executions within FUZZ_MAX_TIME_S fails.
+fuzz_stage() {
+  log "fuzz stage: packet decoder, clang -fsanitize=fuzzer,address,undefined"
+  CC=clang CXX=clang++ configure_and_build_targets "$FUZZ_BUILD_DIR" swarmlio_packet_decoder_fuzz \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSWARMLIO_FUZZ=ON -DBUILD_TESTING=OFF \
+    -DSWARMLIO_BUILD_BENCHMARKS=OFF
+  local bin="$FUZZ_BUILD_DIR/tools/fuzz/swarmlio_packet_decoder_fuzz"
+  local work="$FUZZ_BUILD_DIR/fuzz-run"
+  rm -rf "$work"
+  mkdir -p "$work/seeds" "$work/corpus" "$work/artifacts"
+  "$bin" --write_seeds="$work/seeds"
+  log "fuzzing: $FUZZ_RUNS runs (cap ${FUZZ_MAX_TIME_S} s), log in $work/fuzz.log"
+  local rc=0 start=$SECONDS
+  "$bin" -runs="$FUZZ_RUNS" -max_total_time="$FUZZ_MAX_TIME_S" -timeout=10 -max_len=1300 \
+    -print_final_stats=1 -artifact_prefix="$work/artifacts/" "$work/corpus" "$work/seeds" \
+    >"$work/fuzz.log" 2>&1 || rc=$?
+  if [[ $rc -ne 0 ]]; then
+    tail -n 60 "$work/fuzz.log" >&2
+    log "fuzz stage FAILED (exit $rc); reproduce with: $bin $work/artifacts/<file>"
+    return 1
+  fi
+  local executed
+  executed=$(sed -n 's/^stat::number_of_executed_units: *//p' "$work/fuzz.log")
+  log "fuzz: ${executed:-?} executions in $((SECONDS - start)) s," \
+    "$(sed -n 's/^stat::average_exec_per_sec: *//p' "$work/fuzz.log") exec/s, 0 crashes"
+  if [[ -z "$executed" || "$executed" -lt "$FUZZ_RUNS" ]]; then
+    log "fuzz stage FAILED: only ${executed:-0} of $FUZZ_RUNS executions within ${FUZZ_MAX_TIME_S} s"
+    return 1
+  fi
+}
+
+# ThreadSanitizer on the tests that run more than one thread: the simulator's
+# per-drone workers (Simulator::Run with num_threads = 2) in-process and
+# through the swarmlio_sim tool. No other library code starts threads.
+TSAN_TESTS='^(Scenario\.ParsesAndSimulatesDeterministically|Imperfections\.RealisticRunLosesAndJittersImuSamples|sim\.same_seed_gives_identical_bytes(_realistic)?)$'
+tsan_stage() {
+  log "thread sanitizer stage: -fsanitize=thread on the threaded simulator tests"
+  # libpcl_io loads Debian's uninstrumented libOpenNI2, whose static destructors
+  # unlock destroyed mutexes at exit (not our code). The options also apply to
+  # the build, which runs the test binary to list its tests.
+  mkdir -p "$TSAN_BUILD_DIR"
+  printf 'mutex:libOpenNI2.so\n' >"$TSAN_BUILD_DIR/tsan.supp"
+  local -x TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$TSAN_BUILD_DIR/tsan.supp"
+  configure_and_build_targets "$TSAN_BUILD_DIR" "swarmlio_sim_tests swarmlio_sim_tool swarmlio_bag_info" \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSWARMLIO_BUILD_BENCHMARKS=OFF \
+    -DCMAKE_CXX_FLAGS=-fsanitize=thread -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread \
+    -DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread
+  log "running the threaded tests in $TSAN_BUILD_DIR"
+  ctest --test-dir "$TSAN_BUILD_DIR" -j"$JOBS" --output-on-failure --timeout 600 \
+    -R "$TSAN_TESTS" --no-tests=error
+}
+
 run_tests() {
   local dir="$1"
   log "running tests in $dir"
@@ -94,9 +173,19 @@ case "$cmd" in
       -DSWARMLIO_SANITIZE=ON -DSWARMLIO_BUILD_BENCHMARKS=OFF
     ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
       UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" run_tests "$ASAN_BUILD_DIR"
+    fuzz_stage
+    tsan_stage
+    ;;
+  fuzz)
+    install_packages
+    fuzz_stage
+    ;;
+  tsan)
+    install_packages
+    tsan_stage
     ;;
   *)
-    echo "usage: tools/swarmlio.sh {setup|demo|test}" >&2
+    echo "usage: tools/swarmlio.sh {setup|demo|test|fuzz|tsan}" >&2
     exit 2
     ;;
 esac
