@@ -8,33 +8,39 @@
 namespace swarmlio::net::internal {
 
 namespace {
-constexpr uint8_t kDegeneratedFlag = 0x01;
+// The bits byte: quaternion largest index, degenerated, observation count.
+constexpr uint8_t kLargestMask = 0x03;
+constexpr uint8_t kDegeneratedFlag = 0x04;
+constexpr int kCountShift = 3;
+
 Status DecodeObservation(WireReader* r, TeammateObservation* o) {
   uint8_t id = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("observed_id", &id));
   o->observed_id = id;
-  SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("p_bk_in_bj", r, &o->p_bk_in_bj));
-  return ReadUpperTriangleF32<3>("cov_p_bk_in_bj", r, &o->cov_p_bk_in_bj);
+  SWARMLIO_RETURN_IF_ERROR(
+      ReadScaledVectorI16("p_bk_in_bj", kObservationPositionStepM, r, &o->p_bk_in_bj));
+  return ReadCovariance<3>("cov_p_bk_in_bj", r, &o->cov_p_bk_in_bj);
 }
 
 }  // namespace
 
 void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
+  const QuaternionCodes q = EncodeQuaternion(m.q_Gj_bj);
   w->I64(m.stamp_ns);
-  w->I64(m.session_start_ns);
-  WriteQuaternionF32(m.q_Gj_bj, w);
-  WriteVectorF64(m.p_bj_in_Gj, w);
-  WriteVectorF32(m.v_bj_in_Gj, w);
-  WriteVectorF32(m.omega_bj_in_bj, w);
-  WriteUpperTriangleF32<3>(m.cov_theta_Gj_bj, w);
-  WriteUpperTriangleF32<3>(m.cov_p_bj_in_Gj, w);
-  WriteUpperTriangleF32<3>(m.cov_v_bj_in_Gj, w);
-  w->U8(m.degenerated ? kDegeneratedFlag : 0);
-  w->U8(static_cast<uint8_t>(m.observations.size()));
+  w->I48(m.stamp_ns - m.session_start_ns);
+  w->U8(static_cast<uint8_t>(q.largest | (m.degenerated ? kDegeneratedFlag : 0) |
+                             (m.observations.size() << kCountShift)));
+  WriteQuaternion(q, w);
+  WriteVectorF32(m.p_bj_in_Gj, w);
+  WriteVectorF16(m.v_bj_in_Gj, w);
+  WriteVectorF16(m.omega_bj_in_bj, w);
+  WriteCovariance<3>(m.cov_theta_Gj_bj, w);
+  WriteCovariance<3>(m.cov_p_bj_in_Gj, w);
+  WriteCovariance<3>(m.cov_v_bj_in_Gj, w);
   for (const TeammateObservation& o : m.observations) {
     w->U8(static_cast<uint8_t>(o.observed_id));
-    WriteVectorF32(o.p_bk_in_bj, w);
-    WriteUpperTriangleF32<3>(o.cov_p_bk_in_bj, w);
+    WriteScaledVectorI16(o.p_bk_in_bj, kObservationPositionStepM, w);
+    WriteCovariance<3>(o.cov_p_bk_in_bj, w);
   }
 }
 
@@ -42,34 +48,37 @@ Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* out) {
   EgoStateMessage m;
   m.sender_id = sender_id;
   SWARMLIO_RETURN_IF_ERROR(r->I64("stamp_ns", &m.stamp_ns));
-  SWARMLIO_RETURN_IF_ERROR(r->I64("session_start_ns", &m.session_start_ns));
-  SWARMLIO_RETURN_IF_ERROR(ReadQuaternionF32("q_Gj_bj", r, &m.q_Gj_bj));
-  SWARMLIO_RETURN_IF_ERROR(ReadVectorF64("p_bj_in_Gj", r, &m.p_bj_in_Gj));
-  SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("v_bj_in_Gj", r, &m.v_bj_in_Gj));
-  SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("omega_bj_in_bj", r, &m.omega_bj_in_bj));
-  SWARMLIO_RETURN_IF_ERROR(ReadUpperTriangleF32<3>("cov_theta_Gj_bj", r, &m.cov_theta_Gj_bj));
-  SWARMLIO_RETURN_IF_ERROR(ReadUpperTriangleF32<3>("cov_p_bj_in_Gj", r, &m.cov_p_bj_in_Gj));
-  SWARMLIO_RETURN_IF_ERROR(ReadUpperTriangleF32<3>("cov_v_bj_in_Gj", r, &m.cov_v_bj_in_Gj));
-  uint8_t flags = 0;
-  SWARMLIO_RETURN_IF_ERROR(r->U8("flags", &flags));
-  if ((flags & ~kDegeneratedFlag) != 0) {
-    return Status::DataLoss("field 'flags': unknown bits set (" + std::to_string(flags) + ")");
+  int64_t session_offset = 0;
+  SWARMLIO_RETURN_IF_ERROR(r->I48("stamp_ns - session_start_ns", &session_offset));
+  if (__builtin_sub_overflow(m.stamp_ns, session_offset, &m.session_start_ns)) {
+    return r->Invalid("session_start_ns", -1, "overflows int64");
   }
-  m.degenerated = (flags & kDegeneratedFlag) != 0;
-  uint8_t count = 0;
-  SWARMLIO_RETURN_IF_ERROR(r->U8("observation count", &count));
+  uint8_t bits = 0;
+  SWARMLIO_RETURN_IF_ERROR(r->U8("bits", &bits));
+  m.degenerated = (bits & kDegeneratedFlag) != 0;
+  const int count = bits >> kCountShift;
   if (count > EgoStateMessage::kMaxObservations) {
     return Status::DataLoss("observation count " + std::to_string(count) + " exceeds the maximum " +
                             std::to_string(EgoStateMessage::kMaxObservations));
   }
-  if (static_cast<size_t>(count) * kObservationBytes != r->remaining()) {
+  const size_t after_fixed = kEgoStateFixedBytes - r->position();
+  if (after_fixed > r->remaining() ||
+      static_cast<size_t>(count) * kObservationBytes != r->remaining() - after_fixed) {
     return Status::DataLoss("observation count " + std::to_string(count) + " needs " +
-                            std::to_string(count * kObservationBytes) + " bytes but " +
-                            std::to_string(r->remaining()) + " remain");
+                            std::to_string(kEgoStateFixedBytes + count * kObservationBytes) +
+                            " payload bytes but the payload has " +
+                            std::to_string(r->position() + r->remaining()));
   }
-  m.observations.resize(count);
+  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Gj_bj", bits & kLargestMask, r, &m.q_Gj_bj));
+  SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("p_bj_in_Gj", r, &m.p_bj_in_Gj));
+  SWARMLIO_RETURN_IF_ERROR(ReadVectorF16("v_bj_in_Gj", r, &m.v_bj_in_Gj));
+  SWARMLIO_RETURN_IF_ERROR(ReadVectorF16("omega_bj_in_bj", r, &m.omega_bj_in_bj));
+  SWARMLIO_RETURN_IF_ERROR(ReadCovariance<3>("cov_theta_Gj_bj", r, &m.cov_theta_Gj_bj));
+  SWARMLIO_RETURN_IF_ERROR(ReadCovariance<3>("cov_p_bj_in_Gj", r, &m.cov_p_bj_in_Gj));
+  SWARMLIO_RETURN_IF_ERROR(ReadCovariance<3>("cov_v_bj_in_Gj", r, &m.cov_v_bj_in_Gj));
+  m.observations.resize(static_cast<size_t>(count));
   for (int i = 0; i < count; ++i) {
-    const Status s = DecodeObservation(r, &m.observations[i]);
+    const Status s = DecodeObservation(r, &m.observations[static_cast<size_t>(i)]);
     if (!s.ok()) return s.WithContext("observations[" + std::to_string(i) + "]");
   }
   SWARMLIO_RETURN_IF_ERROR(r->ExpectEnd("payload"));

@@ -1,70 +1,98 @@
-// Wire helpers shared by the payload codecs: quaternions (x y z w, float32)
-// and symmetric matrices as float32 upper triangles (row-major).
+// Wire helpers shared by the payload codecs: the field encodings of
+// wire_format.h (float32 and float16 vectors, scaled int16 vectors,
+// smallest-three quaternions, log-variance / partial-correlation covariances)
+// on top of WireWriter / WireReader. Readers check every decoded code's range
+// and return DataLoss naming the field.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
 
+#include "src/net/covariance_codec.h"
+#include "src/net/half_float.h"
+#include "src/net/quaternion_codec.h"
 #include "src/net/wire_reader.h"
 #include "src/net/wire_writer.h"
 #include "swarmlio/common/status.h"
+#include "swarmlio/net/wire_format.h"
 
 namespace swarmlio::net::internal {
-
-inline void WriteQuaternionF32(const Eigen::Quaterniond& q, WireWriter* w) {
-  w->F32(q.x());
-  w->F32(q.y());
-  w->F32(q.z());
-  w->F32(q.w());
-}
-
-/// Error messages index the coefficients in wire order: [0..3] = x y z w.
-inline Status ReadQuaternionF32(const char* field, WireReader* r, Eigen::Quaterniond* q) {
-  double x = 0, y = 0, z = 0, qw = 0;
-  SWARMLIO_RETURN_IF_ERROR(r->F32(field, 0, &x));
-  SWARMLIO_RETURN_IF_ERROR(r->F32(field, 1, &y));
-  SWARMLIO_RETURN_IF_ERROR(r->F32(field, 2, &z));
-  SWARMLIO_RETURN_IF_ERROR(r->F32(field, 3, &qw));
-  *q = Eigen::Quaterniond(qw, x, y, z);
-  return Status::Ok();
-}
 
 inline void WriteVectorF32(const Eigen::Vector3d& v, WireWriter* w) {
   for (int i = 0; i < 3; ++i) w->F32(v[i]);
 }
-inline void WriteVectorF64(const Eigen::Vector3d& v, WireWriter* w) {
-  for (int i = 0; i < 3; ++i) w->F64(v[i]);
-}
-
 inline Status ReadVectorF32(const char* field, WireReader* r, Eigen::Vector3d* v) {
   for (int i = 0; i < 3; ++i) SWARMLIO_RETURN_IF_ERROR(r->F32(field, i, &(*v)[i]));
   return Status::Ok();
 }
-inline Status ReadVectorF64(const char* field, WireReader* r, Eigen::Vector3d* v) {
-  for (int i = 0; i < 3; ++i) SWARMLIO_RETURN_IF_ERROR(r->F64(field, i, &(*v)[i]));
+
+/// Precondition: FitsHalf for every coefficient.
+inline void WriteVectorF16(const Eigen::Vector3d& v, WireWriter* w) {
+  for (int i = 0; i < 3; ++i) w->U16(HalfFromDouble(v[i]));
+}
+inline Status ReadVectorF16(const char* field, WireReader* r, Eigen::Vector3d* v) {
+  for (int i = 0; i < 3; ++i) SWARMLIO_RETURN_IF_ERROR(r->F16(field, i, &(*v)[i]));
   return Status::Ok();
 }
 
-/// Writes the N(N+1)/2 upper-triangle entries (row-major); the lower triangle is ignored.
-template <int N>
-void WriteUpperTriangleF32(const Eigen::Matrix<double, N, N>& m, WireWriter* w) {
-  for (int row = 0; row < N; ++row) {
-    for (int col = row; col < N; ++col) w->F32(m(row, col));
+/// int16 codes round(v / step); precondition: |v / step| rounds to <= 32767.
+inline void WriteScaledVectorI16(const Eigen::Vector3d& v, double step, WireWriter* w) {
+  for (int i = 0; i < 3; ++i) w->I16(static_cast<int16_t>(std::lround(v[i] / step)));
+}
+/// Rejects the code -32768 (the range is symmetric, +-32767 steps).
+inline Status ReadScaledVectorI16(const char* field,
+                                  double step,
+                                  WireReader* r,
+                                  Eigen::Vector3d* v) {
+  for (int i = 0; i < 3; ++i) {
+    int16_t code = 0;
+    SWARMLIO_RETURN_IF_ERROR(r->I16(field, i, &code));
+    if (code == INT16_MIN) return r->Invalid(field, i, "has the out-of-range code -32768");
+    (*v)[i] = code * step;
   }
+  return Status::Ok();
 }
 
-/// Reads an upper triangle and mirrors it into a symmetric matrix. Error
-/// messages index the entries in wire order (upper triangle, row-major).
+/// The three sent coefficients; codes.largest travels in the caller's flags byte.
+inline void WriteQuaternion(const QuaternionCodes& codes, WireWriter* w) {
+  for (int16_t c : codes.sent) w->I16(c);
+}
+/// Error messages index the sent codes [0..2].
+inline Status ReadQuaternion(const char* field,
+                             uint8_t largest,
+                             WireReader* r,
+                             Eigen::Quaterniond* q) {
+  QuaternionCodes codes;
+  codes.largest = largest;
+  for (int i = 0; i < 3; ++i) SWARMLIO_RETURN_IF_ERROR(r->I16(field, i, &codes.sent[i]));
+  if (!DecodeQuaternion(codes, q)) {
+    return r->Invalid(field, -1,
+                      "is not a canonical smallest-three code (a code of -32768, or a sent "
+                      "coefficient not below the restored one)");
+  }
+  return Status::Ok();
+}
+
+/// Precondition: the upper triangle is finite, the diagonal in
+/// [0, MaxEncodableVariance()] (CheckMessage).
 template <int N>
-Status ReadUpperTriangleF32(const char* field, WireReader* r, Eigen::Matrix<double, N, N>* m) {
-  int index = 0;
-  for (int row = 0; row < N; ++row) {
-    for (int col = row; col < N; ++col) {
-      double value = 0.0;
-      SWARMLIO_RETURN_IF_ERROR(r->F32(field, index++, &value));
-      (*m)(row, col) = value;
-      (*m)(col, row) = value;
-    }
+void WriteCovariance(const Eigen::Matrix<double, N, N>& m, WireWriter* w) {
+  uint8_t codes[CovarianceBytes(N)];
+  EncodeCovariance<N>(m, codes);
+  for (uint8_t c : codes) w->U8(c);
+}
+/// Error messages index the codes in wire order (variances, then correlations).
+template <int N>
+Status ReadCovariance(const char* field, WireReader* r, Eigen::Matrix<double, N, N>* m) {
+  uint8_t codes[CovarianceBytes(N)];
+  for (size_t i = 0; i < CovarianceBytes(N); ++i) {
+    SWARMLIO_RETURN_IF_ERROR(r->U8(field, static_cast<int>(i), &codes[i]));
+  }
+  int bad = -1;
+  if (!DecodeCovariance<N>(codes, m, &bad)) {
+    return r->Invalid(field, bad, "has the out-of-range correlation code -128");
   }
   return Status::Ok();
 }

@@ -8,20 +8,25 @@
 namespace swarmlio::net::internal {
 namespace {
 
+// The entry's bits byte: quaternion largest index, source.
+constexpr uint8_t kLargestMask = 0x03;
+constexpr uint8_t kGraphSourceFlag = 0x04;
+constexpr uint8_t kKnownBits = kLargestMask | kGraphSourceFlag;
+
 Status DecodeEntry(WireReader* r, GlobalExtrinsicEntry* e) {
   uint8_t id = 0;
-  uint8_t source = 0;
+  uint8_t bits = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("teammate_id", &id));
-  SWARMLIO_RETURN_IF_ERROR(r->U8("source", &source));
-  if (source != static_cast<uint8_t>(ExtrinsicSource::kTrajectoryMatch) &&
-      source != static_cast<uint8_t>(ExtrinsicSource::kGraph)) {
-    return Status::DataLoss("field 'source': unknown value " + std::to_string(source));
+  SWARMLIO_RETURN_IF_ERROR(r->U8("bits", &bits));
+  if ((bits & ~kKnownBits) != 0) {
+    return Status::DataLoss("field 'bits': unknown bits set (" + std::to_string(bits) + ")");
   }
   e->teammate_id = id;
-  e->source = static_cast<ExtrinsicSource>(source);
-  SWARMLIO_RETURN_IF_ERROR(ReadQuaternionF32("q_Gi_Gj", r, &e->q_Gi_Gj));
-  SWARMLIO_RETURN_IF_ERROR(ReadVectorF64("p_Gj_in_Gi", r, &e->p_Gj_in_Gi));
-  return ReadUpperTriangleF32<6>("covariance", r, &e->covariance);
+  e->source =
+      (bits & kGraphSourceFlag) != 0 ? ExtrinsicSource::kGraph : ExtrinsicSource::kTrajectoryMatch;
+  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Gi_Gj", bits & kLargestMask, r, &e->q_Gi_Gj));
+  SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("p_Gj_in_Gi", r, &e->p_Gj_in_Gi));
+  return ReadCovariance<6>("covariance", r, &e->covariance);
 }
 
 }  // namespace
@@ -29,14 +34,16 @@ Status DecodeEntry(WireReader* r, GlobalExtrinsicEntry* e) {
 void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& m, WireWriter* w) {
   w->I64(m.stamp_ns);
   WriteVectorF32(m.g_in_Gi, w);
-  WriteUpperTriangleF32<3>(m.cov_g_in_Gi, w);
+  WriteCovariance<3>(m.cov_g_in_Gi, w);
   w->U8(static_cast<uint8_t>(m.entries.size()));
   for (const GlobalExtrinsicEntry& e : m.entries) {
+    const QuaternionCodes q = EncodeQuaternion(e.q_Gi_Gj);
     w->U8(static_cast<uint8_t>(e.teammate_id));
-    w->U8(static_cast<uint8_t>(e.source));
-    WriteQuaternionF32(e.q_Gi_Gj, w);
-    WriteVectorF64(e.p_Gj_in_Gi, w);
-    WriteUpperTriangleF32<6>(e.covariance, w);
+    w->U8(static_cast<uint8_t>(q.largest |
+                               (e.source == ExtrinsicSource::kGraph ? kGraphSourceFlag : 0)));
+    WriteQuaternion(q, w);
+    WriteVectorF32(e.p_Gj_in_Gi, w);
+    WriteCovariance<6>(e.covariance, w);
   }
 }
 
@@ -45,7 +52,7 @@ Status DecodeGlobalExtrinsic(int sender_id, WireReader* r, GlobalExtrinsicMessag
   m.sender_id = sender_id;
   SWARMLIO_RETURN_IF_ERROR(r->I64("stamp_ns", &m.stamp_ns));
   SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("g_in_Gi", r, &m.g_in_Gi));
-  SWARMLIO_RETURN_IF_ERROR(ReadUpperTriangleF32<3>("cov_g_in_Gi", r, &m.cov_g_in_Gi));
+  SWARMLIO_RETURN_IF_ERROR(ReadCovariance<3>("cov_g_in_Gi", r, &m.cov_g_in_Gi));
   uint8_t count = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("entry count", &count));
   if (count > GlobalExtrinsicMessage::kMaxEntries) {
@@ -59,7 +66,7 @@ Status DecodeGlobalExtrinsic(int sender_id, WireReader* r, GlobalExtrinsicMessag
   }
   m.entries.resize(count);
   for (int i = 0; i < count; ++i) {
-    const Status s = DecodeEntry(r, &m.entries[i]);
+    const Status s = DecodeEntry(r, &m.entries[static_cast<size_t>(i)]);
     if (!s.ok()) return s.WithContext("entries[" + std::to_string(i) + "]");
   }
   SWARMLIO_RETURN_IF_ERROR(r->ExpectEnd("payload"));

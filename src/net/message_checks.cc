@@ -4,14 +4,20 @@
 #include <string>
 #include <utility>
 
+#include "src/net/covariance_codec.h"
+#include "src/net/half_float.h"
 #include "swarmlio/net/packet_codec.h"
 #include "swarmlio/net/swarm_limits.h"
+#include "swarmlio/net/wire_format.h"
 
 namespace swarmlio::net {
 namespace {
 
-// |norm - 1| bound for a transmitted unit quaternion (float32 rounding is ~1e-7).
+// |norm - 1| bound for a unit quaternion handed to the encoder (it sends the
+// normalized one; decoded quaternions are unit to 1e-15).
 constexpr double kUnitQuaternionTolerance = 1e-3;
+// stamp_ns - session_start_ns travels as a 48-bit signed integer.
+constexpr int64_t kMaxSessionOffsetNs = (int64_t{1} << 47) - 1;
 
 /// Collects the first violated rule. Field names are `const char*` plus an
 /// optional index and the current list-entry context; the text is built only
@@ -45,6 +51,16 @@ class Checker {
   void Stamp(const char* field, int64_t stamp_ns) {
     if (stamp_ns < 0) Fail(field, -1, "is negative");
   }
+  /// Both stamps >= 0 (checked before), their difference within the 48-bit field.
+  void SessionOffset(int64_t stamp_ns, int64_t session_start_ns) {
+    if (!ok()) return;
+    const int64_t offset = stamp_ns - session_start_ns;  // no overflow: both >= 0
+    if (offset > kMaxSessionOffsetNs || offset < -kMaxSessionOffsetNs) {
+      Fail("session_start_ns", -1,
+           "is more than 2^47 ns (39 h) from stamp_ns (stamp_ns - session_start_ns = " +
+               std::to_string(offset) + " travels in 48 bits)");
+    }
+  }
   /// Finite and representable as a float32 (it travels as one).
   void F32(const char* field, int index, double v) {
     if (!std::isfinite(v) || std::abs(v) > std::numeric_limits<float>::max()) {
@@ -54,33 +70,56 @@ class Checker {
   void Vector32(const char* field, const Eigen::Vector3d& v) {
     for (int i = 0; i < 3; ++i) F32(field, i, v[i]);
   }
-  void Vector64(const char* field, const Eigen::Vector3d& v) {
+  /// Finite and within the float16 range (|v| <= 65504 after rounding).
+  void Vector16(const char* field, const Eigen::Vector3d& v) {
     for (int i = 0; i < 3; ++i) {
-      if (!std::isfinite(v[i])) Fail(field, i, "is not finite");
+      if (!internal::FitsHalf(v[i])) {
+        Fail(field, i,
+             "is not a finite float16 (|x| <= " + std::to_string(internal::kHalfMax) + ")");
+      }
     }
   }
-  /// The norm is taken of the float32-rounded coefficients, as they travel.
+  /// Finite and within the int16 range of the observation position code
+  /// (the same division the writer rounds: |x / step| < 32767.5).
+  void ObservationPosition(const char* field, const Eigen::Vector3d& v) {
+    for (int i = 0; i < 3; ++i) {
+      if (!std::isfinite(v[i]) ||
+          !(std::abs(v[i] / kObservationPositionStepM) < kObservationPositionMaxCode + 0.5)) {
+        Fail(field, i,
+             "= " + std::to_string(v[i]) + " m is outside the wire range +-" +
+                 std::to_string(kObservationPositionMaxM) + " m");
+      }
+    }
+  }
   void UnitQuaternion(const char* field, const Eigen::Quaterniond& q) {
     const Eigen::Vector4d c = q.coeffs();
-    double norm2 = 0.0;
     for (int i = 0; i < 4; ++i) {
-      F32(field, i, c[i]);
-      const double rounded = static_cast<double>(static_cast<float>(c[i]));
-      norm2 += rounded * rounded;
+      if (!std::isfinite(c[i])) Fail(field, i, "is not finite");
     }
-    if (ok() && std::abs(std::sqrt(norm2) - 1.0) > kUnitQuaternionTolerance) {
-      Fail(field, -1, "is not a unit quaternion (norm " + std::to_string(std::sqrt(norm2)) + ")");
+    if (ok() && std::abs(c.norm() - 1.0) > kUnitQuaternionTolerance) {
+      Fail(field, -1, "is not a unit quaternion (norm " + std::to_string(c.norm()) + ")");
     }
   }
-  /// Upper triangle finite in float32, diagonal >= 0.
+  /// Upper triangle finite, diagonal in [0, MaxEncodableVariance()].
   template <int N>
   void Covariance(const char* field, const Eigen::Matrix<double, N, N>& m) {
     for (int row = 0; row < N; ++row) {
-      for (int col = row; col < N; ++col) F32(field, -1, m(row, col));
+      for (int col = row; col < N; ++col) {
+        if (!std::isfinite(m(row, col))) {
+          Fail(field, -1,
+               "is not finite at (" + std::to_string(row) + "," + std::to_string(col) + ")");
+        }
+      }
       if (m(row, row) < 0.0) {
         Fail(
             field, -1,
             "has a negative variance at (" + std::to_string(row) + "," + std::to_string(row) + ")");
+      }
+      if (m(row, row) > internal::MaxEncodableVariance()) {
+        Fail(field, -1,
+             "has a variance above the wire range (" +
+                 std::to_string(internal::MaxEncodableVariance()) + ") at (" + std::to_string(row) +
+                 "," + std::to_string(row) + ")");
       }
     }
   }
@@ -107,10 +146,11 @@ Status Check(const EgoStateMessage& m) {
   c.Id("sender_id", m.sender_id);
   c.Stamp("stamp_ns", m.stamp_ns);
   c.Stamp("session_start_ns", m.session_start_ns);
+  c.SessionOffset(m.stamp_ns, m.session_start_ns);
   c.UnitQuaternion("q_Gj_bj", m.q_Gj_bj);
-  c.Vector64("p_bj_in_Gj", m.p_bj_in_Gj);
-  c.Vector32("v_bj_in_Gj", m.v_bj_in_Gj);
-  c.Vector32("omega_bj_in_bj", m.omega_bj_in_bj);
+  c.Vector32("p_bj_in_Gj", m.p_bj_in_Gj);
+  c.Vector16("v_bj_in_Gj", m.v_bj_in_Gj);
+  c.Vector16("omega_bj_in_bj", m.omega_bj_in_bj);
   c.Covariance<3>("cov_theta_Gj_bj", m.cov_theta_Gj_bj);
   c.Covariance<3>("cov_p_bj_in_Gj", m.cov_p_bj_in_Gj);
   c.Covariance<3>("cov_v_bj_in_Gj", m.cov_v_bj_in_Gj);
@@ -124,7 +164,7 @@ Status Check(const EgoStateMessage& m) {
     c.SetContext("observations[" + std::to_string(i) + "].");
     const TeammateObservation& o = m.observations[i];
     c.TeammateId("observed_id", o.observed_id, m.sender_id, &seen);
-    c.Vector32("p_bk_in_bj", o.p_bk_in_bj);
+    c.ObservationPosition("p_bk_in_bj", o.p_bk_in_bj);
     c.Covariance<3>("cov_p_bk_in_bj", o.cov_p_bk_in_bj);
   }
   return c.status();
@@ -151,7 +191,7 @@ Status Check(const GlobalExtrinsicMessage& m) {
       c.Fail("source", -1, "has an unknown value");
     }
     c.UnitQuaternion("q_Gi_Gj", e.q_Gi_Gj);
-    c.Vector64("p_Gj_in_Gi", e.p_Gj_in_Gi);
+    c.Vector32("p_Gj_in_Gi", e.p_Gj_in_Gi);
     c.Covariance<6>("covariance", e.covariance);
   }
   return c.status();

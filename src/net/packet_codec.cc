@@ -3,6 +3,7 @@
 
 #include <sodium.h>
 
+#include <cstring>
 #include <string>
 #include <type_traits>
 
@@ -12,7 +13,20 @@
 
 namespace swarmlio::net {
 
-static_assert(kTagBytes == crypto_auth_BYTES, "tag size is HMAC-SHA512-256's");
+static_assert(kTagBytes == crypto_verify_16_BYTES && kTagBytes <= crypto_auth_BYTES,
+              "the tag is HMAC-SHA512-256 truncated to 128 bits");
+
+namespace {
+
+/// The first kTagBytes of HMAC-SHA512-256(key, data[0, size)).
+void ComputeTag(const uint8_t* data, size_t size, const uint8_t* key, uint8_t* tag) {
+  uint8_t full[crypto_auth_BYTES];
+  crypto_auth(full, data, size, key);
+  std::memcpy(tag, full, kTagBytes);
+  sodium_memzero(full, sizeof(full));
+}
+
+}  // namespace
 
 Status PacketCodec::Create(const SwarmKey& key, PacketCodec* codec) {
   if (sodium_init() < 0) return Status::Internal("libsodium failed to initialise");
@@ -30,14 +44,11 @@ Status PacketCodec::Encode(const SwarmMessage& message,
   std::vector<uint8_t> bytes;
   bytes.reserve(kMaxPacketBytes);
   internal::WireWriter w(&bytes);
-  w.U8(kMagic0);
-  w.U8(kMagic1);
+  w.U8(kMagic);
   w.U8(kProtocolVersion);
   w.U8(static_cast<uint8_t>(TypeOf(message)));
   w.U8(static_cast<uint8_t>(SenderOf(message)));
-  w.U8(0);  // flags
-  w.U32(sequence);
-  w.U16(0);  // payload length, patched below
+  w.U16(static_cast<uint16_t>(sequence & 0xFFFFu));
   std::visit(
       [&w](const auto& m) {
         using T = std::decay_t<decltype(m)>;
@@ -50,15 +61,12 @@ Status PacketCodec::Encode(const SwarmMessage& message,
         }
       },
       message);
-  const size_t payload = bytes.size() - kHeaderBytes;
-  if (payload + kPacketOverheadBytes > kMaxPacketBytes) {  // unreachable: per-type caps
+  if (bytes.size() + kTagBytes > kMaxPacketBytes) {  // unreachable: per-type caps
     return Status::Internal("encoded packet exceeds " + std::to_string(kMaxPacketBytes) + " bytes");
   }
-  bytes[10] = static_cast<uint8_t>(payload & 0xFF);
-  bytes[11] = static_cast<uint8_t>(payload >> 8);
-  bytes.resize(bytes.size() + kTagBytes);
-  crypto_auth(bytes.data() + kHeaderBytes + payload, bytes.data(), kHeaderBytes + payload,
-              key_.data());
+  const size_t signed_bytes = bytes.size();
+  bytes.resize(signed_bytes + kTagBytes);
+  ComputeTag(bytes.data(), signed_bytes, key_.data(), bytes.data() + signed_bytes);
   *packet = std::move(bytes);
   return Status::Ok();
 }
@@ -75,19 +83,15 @@ Status PacketCodec::Decode(const uint8_t* data, size_t size, DecodedPacket* pack
                             std::to_string(kMaxPacketBytes));
   }
   internal::WireReader header_reader(data, kHeaderBytes);
-  uint8_t magic0 = 0, magic1 = 0, version = 0, type = 0, sender = 0, flags = 0;
+  uint8_t magic = 0, version = 0, type = 0, sender = 0;
+  uint16_t sequence = 0;
   PacketHeader header;
-  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("magic", &magic0));
-  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("magic", &magic1));
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("magic", &magic));
   SWARMLIO_RETURN_IF_ERROR(header_reader.U8("version", &version));
   SWARMLIO_RETURN_IF_ERROR(header_reader.U8("type", &type));
   SWARMLIO_RETURN_IF_ERROR(header_reader.U8("sender", &sender));
-  SWARMLIO_RETURN_IF_ERROR(header_reader.U8("flags", &flags));
-  SWARMLIO_RETURN_IF_ERROR(header_reader.U32("sequence", &header.sequence));
-  SWARMLIO_RETURN_IF_ERROR(header_reader.U16("payload length", &header.payload_bytes));
-  if (magic0 != kMagic0 || magic1 != kMagic1) {
-    return Status::DataLoss("not a swarm packet (bad magic)");
-  }
+  SWARMLIO_RETURN_IF_ERROR(header_reader.U16("sequence", &sequence));
+  if (magic != kMagic) return Status::DataLoss("not a swarm packet (bad magic)");
   if (version != kProtocolVersion) {
     return Status::InvalidArgument("unsupported protocol version " + std::to_string(version) +
                                    " (this build speaks " + std::to_string(kProtocolVersion) + ")");
@@ -96,21 +100,20 @@ Status PacketCodec::Decode(const uint8_t* data, size_t size, DecodedPacket* pack
       type > static_cast<uint8_t>(MessageType::kTimeSync)) {
     return Status::InvalidArgument("unknown message type " + std::to_string(type));
   }
-  if (flags != 0) return Status::DataLoss("header flags must be 0, got " + std::to_string(flags));
   if (!IsValidDroneId(sender)) {
     return Status::DataLoss("sender id " + std::to_string(sender) + " out of range");
   }
-  if (kPacketOverheadBytes + header.payload_bytes != size) {
-    return Status::DataLoss("payload length " + std::to_string(header.payload_bytes) +
-                            " does not match the packet size " + std::to_string(size));
-  }
-  const size_t signed_bytes = kHeaderBytes + header.payload_bytes;
-  if (crypto_auth_verify(data + signed_bytes, data, signed_bytes, key_.data()) != 0) {
+  const size_t signed_bytes = size - kTagBytes;
+  uint8_t tag[kTagBytes];
+  ComputeTag(data, signed_bytes, key_.data(), tag);
+  if (crypto_verify_16(tag, data + signed_bytes) != 0) {
     return Status::DataLoss("authentication tag mismatch (wrong swarm key or corrupted packet)");
   }
   header.version = version;
   header.type = static_cast<MessageType>(type);
   header.sender_id = sender;
+  header.sequence = sequence;
+  header.payload_bytes = static_cast<uint16_t>(signed_bytes - kHeaderBytes);
 
   internal::WireReader r(data + kHeaderBytes, header.payload_bytes);
   DecodedPacket decoded;

@@ -22,15 +22,14 @@ using net_test::MakeTimeSync;
 
 constexpr uint64_t kKeySeed = 7;
 
-/// Recomputes length and tag after a test edited the payload, so that the
+/// Recomputes the tag after a test edited the packet, so that the header and
 /// payload checks (not the tag) must catch the edit.
 void Resign(std::vector<uint8_t>* packet) {
-  const size_t payload = packet->size() - kPacketOverheadBytes;
-  (*packet)[10] = static_cast<uint8_t>(payload & 0xFF);
-  (*packet)[11] = static_cast<uint8_t>(payload >> 8);
   const SwarmKey key = SwarmKey::ForSimulation(kKeySeed);
-  crypto_auth(packet->data() + packet->size() - kTagBytes, packet->data(),
-              packet->size() - kTagBytes, key.data());
+  const size_t signed_bytes = packet->size() - kTagBytes;
+  uint8_t full[crypto_auth_BYTES];
+  crypto_auth(full, packet->data(), signed_bytes, key.data());
+  std::memcpy(packet->data() + signed_bytes, full, kTagBytes);
 }
 
 std::vector<uint8_t> Encode(const SwarmMessage& m) {
@@ -75,12 +74,14 @@ TEST(PacketCodecRobustness, RandomCorruptionNeverCrashesAndIsRejected) {
   int tag_rejections = 0;
   constexpr int kTrials = 20000;
   for (int trial = 0; trial < kTrials; ++trial) {
-    std::vector<uint8_t> packet = Encode(messages[trial % messages.size()]);
+    const std::vector<uint8_t> original = Encode(messages[trial % messages.size()]);
+    std::vector<uint8_t> packet = original;
     const int flips = 1 + static_cast<int>(rng() % 4);
     for (int f = 0; f < flips; ++f) {
       const size_t at = rng() % packet.size();
-      packet[at] ^= static_cast<uint8_t>(1 + rng() % 255);  // never a no-op
+      packet[at] ^= static_cast<uint8_t>(1 + rng() % 255);  // never a no-op on its own
     }
+    if (packet == original) continue;  // two flips of one byte cancelled out
     DecodedPacket decoded;
     const Status s = codec.Decode(packet.data(), packet.size(), &decoded);
     ASSERT_FALSE(s.ok()) << "trial " << trial;
@@ -97,8 +98,8 @@ TEST(PacketCodecRobustness, RandomGarbageIsRejected) {
     std::vector<uint8_t> bytes(rng() % (kMaxPacketBytes + 100));
     for (uint8_t& b : bytes) b = static_cast<uint8_t>(rng());
     if (bytes.size() >= 2 && trial % 2 == 0) {  // half of them look like ours
-      bytes[0] = kMagic0;
-      bytes[1] = kMagic1;
+      bytes[0] = kMagic;
+      bytes[1] = kProtocolVersion;
     }
     DecodedPacket decoded;
     EXPECT_FALSE(codec.Decode(bytes.data(), bytes.size(), &decoded).ok());
@@ -120,51 +121,70 @@ TEST(PacketCodecRobustness, HeaderChecks) {
   p[0] = 'X';
   ExpectRejected(p, "bad magic");
   p = good;
-  p[2] = kProtocolVersion + 1;
+  p[1] = kProtocolVersion + 1;
   EXPECT_EQ(Decode(p).code(), Status::Code::kInvalidArgument);
   ExpectRejected(p, "unsupported protocol version " + std::to_string(kProtocolVersion + 1));
-  p[2] = 1;  // version 1: GlobalExtrinsic without gravity
-  ExpectRejected(p, "unsupported protocol version 1");
+  p[1] = 'L';  // a version 1/2 packet: 'S' 'L' version ...
+  ExpectRejected(p, "unsupported protocol version 76");
   p = good;
-  p[3] = 9;
+  p[2] = 9;
   ExpectRejected(p, "unknown message type 9");
   p = good;
-  p[3] = 0;
+  p[2] = 0;
   ExpectRejected(p, "unknown message type 0");
   p = good;
-  p[5] = 1;
-  ExpectRejected(p, "flags");
-  p = good;
-  p[4] = kMaxSwarmSize;
+  p[3] = kMaxSwarmSize;
   ExpectRejected(p, "sender id 64");
-  p = good;
-  p[10] = static_cast<uint8_t>(p[10] + 1);
-  ExpectRejected(p, "payload length");
-  p = good;
-  p[11] = 0xFF;
-  ExpectRejected(p, "payload length");
+  p = good;  // checks before the tag only need the header: a header-only packet
+  p.resize(kPacketOverheadBytes - 1);
+  ExpectRejected(p, "shorter than header + tag");
   std::vector<uint8_t> huge(kMaxPacketBytes + 1, 0);
   ExpectRejected(huge, "exceeds the cap");
+  // The header is authenticated: any edit that passes the checks fails the tag.
+  p = good;
+  p[3] = 2;  // another sender
+  ExpectRejected(p, "authentication tag mismatch");
+  p = good;
+  p[4] ^= 1;  // another sequence number
+  ExpectRejected(p, "authentication tag mismatch");
+}
+
+/// Payload offsets of the EgoState fields (wire_format.h).
+constexpr size_t kEgoBits = kHeaderBytes + 14;
+constexpr size_t kEgoQuaternion = kHeaderBytes + 15;
+constexpr size_t kEgoPosition = kHeaderBytes + 21;
+constexpr size_t kEgoVelocity = kHeaderBytes + 33;
+constexpr size_t kEgoOmega = kHeaderBytes + 39;
+constexpr size_t kEgoCovP = kHeaderBytes + 51;
+constexpr size_t kEgoFirstObservation = kHeaderBytes + kEgoStateFixedBytes;
+
+void PutU16(std::vector<uint8_t>* p, size_t at, uint16_t value) {
+  (*p)[at] = static_cast<uint8_t>(value & 0xFF);
+  (*p)[at + 1] = static_cast<uint8_t>(value >> 8);
+}
+
+void SetCount(std::vector<uint8_t>* p, int count) {
+  (*p)[kEgoBits] = static_cast<uint8_t>(((*p)[kEgoBits] & 0x07) | (count << 3));
 }
 
 TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
-  constexpr size_t kCountOffset = kHeaderBytes + kEgoStateFixedBytes - 1;
   const std::vector<uint8_t> ego = Encode(MakeEgoState(1, 2, 5));
-  {  // sanity: Resign alone keeps a packet valid
+  {  // sanity: Resign alone keeps a packet valid, and the count is where we think
     std::vector<uint8_t> p = ego;
     Resign(&p);
     EXPECT_TRUE(Decode(p).ok());
+    EXPECT_EQ(p[kEgoBits] >> 3, 2);
   }
   {  // over-long list: a count above the cap, with the bytes present
     std::vector<uint8_t> p = Encode(MakeEgoState(1, EgoStateMessage::kMaxObservations, 5));
     p.insert(p.end() - kTagBytes, kObservationBytes, 0);
-    p[kCountOffset] = EgoStateMessage::kMaxObservations + 1;
+    SetCount(&p, EgoStateMessage::kMaxObservations + 1);
     Resign(&p);
-    ExpectRejected(p, "exceeds the maximum");
+    ExpectRejected(p, "observation count 25 exceeds the maximum 24");
   }
   {  // count larger than the bytes present
     std::vector<uint8_t> p = ego;
-    p[kCountOffset] = 3;
+    SetCount(&p, 3);
     Resign(&p);
     ExpectRejected(p, "observation count 3 needs");
   }
@@ -174,71 +194,109 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
     Resign(&p);
     ExpectRejected(p, "observation count 2 needs");
   }
-  {  // NaN in a float32 field (v_bj_in_Gj.x at payload offset 56)
+  {  // a payload shorter than the fixed part
+    std::vector<uint8_t> p = ego;
+    p.erase(p.begin() + kHeaderBytes + 20, p.end() - kTagBytes);
+    Resign(&p);
+    ExpectRejected(p, "needs");
+  }
+  {  // NaN in a float32 field
     std::vector<uint8_t> p = ego;
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    std::memcpy(&p[kHeaderBytes + 56], &nan, 4);
+    std::memcpy(&p[kEgoPosition + 4], &nan, 4);
+    Resign(&p);
+    ExpectRejected(p, "p_bj_in_Gj[1]' is not finite");
+  }
+  {  // Inf and NaN in float16 fields
+    std::vector<uint8_t> p = ego;
+    PutU16(&p, kEgoVelocity, 0x7C00);
     Resign(&p);
     ExpectRejected(p, "v_bj_in_Gj[0]' is not finite");
-  }
-  {  // Inf in a float64 field (p_bj_in_Gj.x at payload offset 32)
-    std::vector<uint8_t> p = ego;
-    const double inf = std::numeric_limits<double>::infinity();
-    std::memcpy(&p[kHeaderBytes + 32], &inf, 8);
+    p = ego;
+    PutU16(&p, kEgoOmega + 4, 0xFE00);
     Resign(&p);
-    ExpectRejected(p, "p_bj_in_Gj[0]' is not finite");
+    ExpectRejected(p, "omega_bj_in_bj[2]' is not finite");
   }
-  {  // a non-unit quaternion (q.w at payload offset 28)
+  {  // quaternion codes that are not a canonical smallest-three encoding
     std::vector<uint8_t> p = ego;
-    const float two = 2.0f;
-    std::memcpy(&p[kHeaderBytes + 28], &two, 4);
+    for (int i = 0; i < 3; ++i) PutU16(&p, kEgoQuaternion + 2 * i, 32767);  // sum c^2 = 1.5
     Resign(&p);
-    ExpectRejected(p, "not a unit quaternion");
+    ExpectRejected(p, "q_Gj_bj' is not a canonical smallest-three code");
+    p = ego;
+    PutU16(&p, kEgoQuaternion + 2, 0x8000);  // -32768
+    Resign(&p);
+    ExpectRejected(p, "q_Gj_bj' is not a canonical smallest-three code");
   }
-  {  // unknown flag bits
+  {  // correlation code -128 (cov_p's third code is its first correlation)
     std::vector<uint8_t> p = ego;
-    p[kCountOffset - 1] = 0x80;
+    p[kEgoCovP + 3] = 0x80;
     Resign(&p);
-    ExpectRejected(p, "unknown bits");
+    ExpectRejected(p, "cov_p_bj_in_Gj[3]' has the out-of-range correlation code -128");
   }
-  const size_t first_observation = kCountOffset + 1;
+  {  // stamps: an overflowing session start, a negative stamp, a negative session start
+    std::vector<uint8_t> p = ego;  // stamp_ns = INT64_MIN, stamp - session > 0
+    for (int i = 0; i < 8; ++i) p[kHeaderBytes + i] = i == 7 ? 0x80 : 0x00;
+    Resign(&p);
+    ExpectRejected(p, "session_start_ns' overflows int64");
+    p = ego;  // stamp_ns = -1
+    for (int i = 0; i < 8; ++i) p[kHeaderBytes + i] = 0xFF;
+    Resign(&p);
+    ExpectRejected(p, "stamp_ns' is negative");
+    p = ego;  // stamp_ns = 5, before the session offset
+    for (int i = 0; i < 8; ++i) p[kHeaderBytes + i] = i == 0 ? 5 : 0;
+    Resign(&p);
+    ExpectRejected(p, "session_start_ns' is negative");
+  }
+  const size_t first = kEgoFirstObservation;
   {  // observed id out of range
     std::vector<uint8_t> p = ego;
-    p[first_observation] = 200;
+    p[first] = 200;
     Resign(&p);
     ExpectRejected(p, "observations[0].observed_id' = 200 is not a drone id");
   }
   {  // observed id equal to the sender
     std::vector<uint8_t> p = ego;
-    p[first_observation] = 1;
+    p[first] = 1;
     Resign(&p);
     ExpectRejected(p, "is the sender itself");
   }
   {  // repeated observed id
     std::vector<uint8_t> p = ego;
-    p[first_observation + kObservationBytes] = p[first_observation];
+    p[first + kObservationBytes] = p[first];
     Resign(&p);
     ExpectRejected(p, "is repeated");
   }
-  {  // negative variance in an observation covariance (entry (0,0))
+  {  // observation position code -32768
     std::vector<uint8_t> p = ego;
-    const float negative = -1.0f;
-    std::memcpy(&p[first_observation + 13], &negative, 4);
+    PutU16(&p, first + 1 + 2, 0x8000);
     Resign(&p);
-    ExpectRejected(p, "negative variance");
+    ExpectRejected(p, "observations[0]: field 'p_bk_in_bj[1]' has the out-of-range code -32768");
   }
   const std::vector<uint8_t> ext = Encode(MakeGlobalExtrinsic(0, 1, 3));
-  {  // unknown extrinsic source
+  const size_t count_at = kHeaderBytes + kGlobalExtrinsicFixedBytes - 1;
+  {  // unknown bits in an entry
     std::vector<uint8_t> p = ext;
-    p[kHeaderBytes + 45 + 1] = 3;  // stamp, gravity (36 B), count, id
+    p[count_at + 2] |= 0x80;  // count, id, bits
     Resign(&p);
-    ExpectRejected(p, "source': unknown value 3");
+    ExpectRejected(p, "entries[0]: field 'bits': unknown bits set");
   }
   {  // entry count above the cap
     std::vector<uint8_t> p = ext;
-    p[kHeaderBytes + 44] = GlobalExtrinsicMessage::kMaxEntries + 1;
+    p[count_at] = GlobalExtrinsicMessage::kMaxEntries + 1;
     Resign(&p);
     ExpectRejected(p, "exceeds the maximum");
+  }
+  {  // a correlation code -128 in the 6x6 covariance (its last code)
+    std::vector<uint8_t> p = ext;
+    p[p.size() - kTagBytes - 1] = 0x80;
+    Resign(&p);
+    ExpectRejected(p, "entries[0]: field 'covariance[20]' has the out-of-range correlation code");
+  }
+  {  // entry teammate id equal to the sender
+    std::vector<uint8_t> p = ext;
+    p[count_at + 1] = 0;
+    Resign(&p);
+    ExpectRejected(p, "is the sender itself");
   }
   const std::vector<uint8_t> sync = Encode(MakeTimeSync(1, 2, false));
   {  // unknown time-sync kind

@@ -1,5 +1,6 @@
 // Round trips, sizes and the header layout of the packet codec.
 #include <gtest/gtest.h>
+#include <sodium.h>
 
 #include <limits>
 
@@ -43,7 +44,7 @@ TEST(PacketCodec, EveryMessageRoundTripsBitExactly) {
     EXPECT_EQ(decoded.header.version, kProtocolVersion);
     EXPECT_EQ(decoded.header.type, TypeOf(message));
     EXPECT_EQ(decoded.header.sender_id, SenderOf(message));
-    EXPECT_EQ(decoded.header.sequence, sequence);
+    EXPECT_EQ(decoded.header.sequence, sequence & 0xFFFFu);  // 16 bits on the wire
     EXPECT_EQ(decoded.header.payload_bytes, packet.size() - kPacketOverheadBytes);
     ExpectSameMessage(message, decoded.message);
 
@@ -55,47 +56,43 @@ TEST(PacketCodec, EveryMessageRoundTripsBitExactly) {
 }
 
 TEST(PacketCodec, DocumentedSizes) {
-  // docs/network.md, "Message sizes".
-  EXPECT_EQ(EgoStatePacketBytes(0), 198u);
-  EXPECT_EQ(EgoStatePacketBytes(1), 235u);
-  EXPECT_EQ(EgoStatePacketBytes(4), 346u);
-  EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 1086u);
-  EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 215u);
-  EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 1097u);
-  EXPECT_EQ(TimeSyncPacketBytes(), 70u);
+  // docs/network.md, "Messages and their sizes".
+  EXPECT_EQ(kPacketOverheadBytes, 22u);
+  EXPECT_EQ(EgoStatePacketBytes(0), 85u);
+  EXPECT_EQ(EgoStatePacketBytes(1), 98u);
+  EXPECT_EQ(EgoStatePacketBytes(2), 111u);
+  EXPECT_EQ(EgoStatePacketBytes(4), 137u);
+  EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 397u);
+  EXPECT_EQ(GlobalExtrinsicPacketBytes(0), 49u);
+  EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 90u);
+  EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 377u);
+  EXPECT_EQ(TimeSyncPacketBytes(), 48u);
 }
 
 TEST(PacketCodec, HeaderIsLittleEndianAndPacked) {
   const PacketCodec codec = MakeCodec();
   std::vector<uint8_t> packet;
   ASSERT_TRUE(codec.Encode(MakeTimeSync(5, 9, false), 0x04030201u, &packet).ok());
+  ASSERT_EQ(packet.size(), TimeSyncPacketBytes());
   const std::vector<uint8_t> header(packet.begin(), packet.begin() + kHeaderBytes);
-  const std::vector<uint8_t> expected = {
-      'S', 'L', kProtocolVersion, 3, 5, 0, 0x01, 0x02, 0x03, 0x04, static_cast<uint8_t>(kTimeSyncBytes), 0};
+  const std::vector<uint8_t> expected = {'S', kProtocolVersion, 3, 5, 0x01, 0x02};
   EXPECT_EQ(header, expected);
   // Payload: target, kind, then t1 little endian.
-  EXPECT_EQ(packet[12], 9);
-  EXPECT_EQ(packet[13], 0);
+  EXPECT_EQ(packet[6], 9);
+  EXPECT_EQ(packet[7], 0);
   const int64_t t1 = 1'000'000'123;
-  for (int i = 0; i < 8; ++i) EXPECT_EQ(packet[14 + i], static_cast<uint8_t>(t1 >> (8 * i)));
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(packet[8 + i], static_cast<uint8_t>(t1 >> (8 * i)));
 }
 
-TEST(PacketCodec, FloatFieldsRoundToFloat32AndGlobalPositionsStayDouble) {
-  const PacketCodec codec = MakeCodec();
-  EgoStateMessage m = MakeEgoState(1, 1, 3);
-  m.v_bj_in_Gj = Eigen::Vector3d(0.1, 1.0 / 3.0, -2.7);
-  m.p_bj_in_Gj = Eigen::Vector3d(1234.56789012345, -0.1, 1.0 / 3.0);
-  m.cov_p_bj_in_Gj(1, 0) = 123.0;  // lower triangle is ignored
+TEST(PacketCodec, TagIsTruncatedHmacSha512256) {
+  const PacketCodec codec = MakeCodec(7);
   std::vector<uint8_t> packet;
-  ASSERT_TRUE(codec.Encode(m, 0, &packet).ok());
-  DecodedPacket decoded;
-  ASSERT_TRUE(codec.Decode(packet.data(), packet.size(), &decoded).ok());
-  const auto& d = std::get<EgoStateMessage>(decoded.message);
-  for (int i = 0; i < 3; ++i) {
-    EXPECT_EQ(d.v_bj_in_Gj[i], net_test::RoundToFloat(m.v_bj_in_Gj[i]));
-  }
-  EXPECT_EQ(d.p_bj_in_Gj, m.p_bj_in_Gj);
-  EXPECT_EQ(d.cov_p_bj_in_Gj(1, 0), m.cov_p_bj_in_Gj(0, 1));
+  ASSERT_TRUE(codec.Encode(MakeEgoState(2, 1, 4), 9, &packet).ok());
+  const SwarmKey key = SwarmKey::ForSimulation(7);
+  uint8_t full[crypto_auth_BYTES];
+  crypto_auth(full, packet.data(), packet.size() - kTagBytes, key.data());
+  const std::vector<uint8_t> tag(packet.end() - kTagBytes, packet.end());
+  EXPECT_EQ(tag, std::vector<uint8_t>(full, full + kTagBytes));
 }
 
 TEST(PacketCodec, EncodeRejectsInvalidMessages) {
@@ -110,8 +107,26 @@ TEST(PacketCodec, EncodeRejectsInvalidMessages) {
   e.v_bj_in_Gj.x() = std::numeric_limits<double>::quiet_NaN();
   expect_rejected(e, "v_bj_in_Gj[0]");
   e = MakeEgoState(2, 2, 1);
-  e.omega_bj_in_bj.z() = 1e39;  // overflows float32
+  e.omega_bj_in_bj.z() = 65520.0;  // rounds to Inf in float16
   expect_rejected(e, "omega_bj_in_bj[2]");
+  e = MakeEgoState(2, 2, 1);
+  e.v_bj_in_Gj.y() = -1e5;
+  expect_rejected(e, "v_bj_in_Gj[1]");
+  e = MakeEgoState(2, 2, 1);
+  e.p_bj_in_Gj.x() = 1e39;  // overflows float32
+  expect_rejected(e, "p_bj_in_Gj[0]");
+  e = MakeEgoState(2, 2, 1);
+  e.observations[1].p_bk_in_bj.z() = 65.6;  // beyond +-65.534 m
+  expect_rejected(e, "observations[1].p_bk_in_bj[2]");
+  e = MakeEgoState(2, 2, 1);
+  e.cov_p_bj_in_Gj(1, 1) = 1e8;  // above 2^23.875
+  expect_rejected(e, "cov_p_bj_in_Gj' has a variance above the wire range");
+  e = MakeEgoState(2, 2, 1);
+  e.cov_theta_Gj_bj(0, 2) = std::numeric_limits<double>::infinity();
+  expect_rejected(e, "cov_theta_Gj_bj' is not finite");
+  e = MakeEgoState(2, 2, 1);
+  e.session_start_ns = e.stamp_ns - (int64_t{1} << 47);  // 39 h before
+  expect_rejected(e, "session_start_ns");
   e = MakeEgoState(2, 2, 1);
   e.p_bj_in_Gj.y() = std::numeric_limits<double>::infinity();
   expect_rejected(e, "p_bj_in_Gj[1]");

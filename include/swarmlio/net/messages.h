@@ -1,12 +1,12 @@
 // Inter-drone messages (plain values; SI units; frames in the names, see
 // docs/conventions.md). Wire encoding and sizes: docs/network.md.
 //
-// Every float field travels as IEEE float32 except stamps (int64 ns) and the
-// global positions p_bj_in_Gj / p_Gj_in_Gi (float64): decoding an encoded
-// message gives back each field rounded to the nearest float32. Covariances
-// travel as upper triangles (row-major: 00 01 02 11 12 22 ...); the encoder
-// reads only the upper triangle and the decoder mirrors it, so decoded
-// covariances are exactly symmetric.
+// The codec quantizes (wire version 3, docs/network.md §2.1): stamps exact,
+// positions float32, quaternions as smallest-three int16 codes, rates
+// float16, observation positions in 2 mm steps, covariances as 8-bit log
+// variances and partial correlations. Decoding gives each field back within
+// that precision; the encoder reads only the upper triangle of a covariance,
+// and decoded covariances are symmetric positive definite.
 #pragma once
 
 #include <Eigen/Core>

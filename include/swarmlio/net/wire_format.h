@@ -1,19 +1,18 @@
-// The swarm packet wire format, version 2 (docs/network.md, "Wire format").
+// The swarm packet wire format, version 3 (docs/network.md, "Wire format").
 //
 //   offset size field
-//   0      2    magic 'S' 'L' (0x53 0x4C)
-//   2      1    protocol version (kProtocolVersion)
-//   3      1    message type (MessageType)
-//   4      1    sender id (0 .. kMaxSwarmSize-1)
-//   5      1    flags (reserved, must be 0)
-//   6      4    sequence number (per sender, +1 per packet)
-//   10     2    payload length P
-//   12     P    payload (per type, below)
-//   12+P   32   tag: HMAC-SHA512-256(swarm key, bytes [0, 12+P))
+//   0      1    magic 'S' (0x53)
+//   1      1    protocol version (kProtocolVersion)
+//   2      1    message type (MessageType)
+//   3      1    sender id (0 .. kMaxSwarmSize-1)
+//   4      2    sequence number (per sender, +1 per packet, low 16 bits)
+//   6      P    payload (per type, below); P = packet size - 22
+//   6+P    16   tag: the first 16 bytes of HMAC-SHA512-256(swarm key, bytes [0, 6+P))
 //
 // All integers are little endian, floats IEEE-754 little endian, no padding.
-// Payload sizes are compile-time functions of the list lengths so that the
-// 1200-byte cap is checked by static_assert.
+// Version 3 quantizes the payload (resolutions and ranges below and in
+// docs/network.md §2.1); every layout has a fixed size per list length, so
+// the 1200-byte cap is checked by static_assert.
 #pragma once
 
 #include <cstddef>
@@ -24,11 +23,11 @@
 
 namespace swarmlio::net {
 
-inline constexpr uint8_t kMagic0 = 0x53;  // 'S'
-inline constexpr uint8_t kMagic1 = 0x4C;  // 'L'
-inline constexpr uint8_t kProtocolVersion = 2;  // 2: gravity in GlobalExtrinsic
-inline constexpr size_t kHeaderBytes = 12;
-inline constexpr size_t kTagBytes = 32;  // crypto_auth_hmacsha512256_BYTES
+inline constexpr uint8_t kMagic = 0x53;  // 'S'
+/// 2: gravity in GlobalExtrinsic; 3: quantized payloads, 6-byte header, 16-byte tag.
+inline constexpr uint8_t kProtocolVersion = 3;
+inline constexpr size_t kHeaderBytes = 6;
+inline constexpr size_t kTagBytes = 16;  // HMAC-SHA512-256 truncated to 128 bits
 inline constexpr size_t kPacketOverheadBytes = kHeaderBytes + kTagBytes;
 
 /// The decoded packet header.
@@ -36,22 +35,49 @@ struct PacketHeader {
   uint8_t version = kProtocolVersion;
   MessageType type = MessageType::kEgoState;
   int sender_id = 0;
-  uint32_t sequence = 0;
-  uint16_t payload_bytes = 0;
+  uint32_t sequence = 0;       // 0 .. 65535 on the wire (the sender's counter mod 2^16)
+  uint16_t payload_bytes = 0;  // packet size - kPacketOverheadBytes
 };
 
+// --- Field encodings (docs/network.md §2.1) ---------------------------------
+// q (unit quaternion), "smallest three": the largest |coefficient| is made
+// positive and dropped (its index, 2 bits, travels in a flags byte); the
+// other three, each in [-1/sqrt2, 1/sqrt2], as int16 code = round(c * kQuaternionScale).
+inline constexpr int kQuaternionMaxCode = 32767;
+inline constexpr double kQuaternionScale = 32767.0 * 1.4142135623730951;
+// f16: IEEE binary16 (|x| <= 65504, relative rounding <= 2^-11).
+// Observation position: int16 code = round(x / kObservationPositionStepM).
+inline constexpr int kObservationPositionMaxCode = 32767;
+inline constexpr double kObservationPositionStepM = 0.002;
+inline constexpr double kObservationPositionMaxM =
+    kObservationPositionMaxCode * kObservationPositionStepM;  // 65.534 m
+// Covariance (N x N, symmetric): N uint8 log-variance codes, then the
+// N(N-1)/2 partial correlations of the lower triangle, row by row
+// ((1,0) (2,0) (2,1) (3,0) ...), as int8 codes. Decoded:
+//   variance_i = 2^(kLogVarianceMin + code_i * kLogVarianceStep)
+//   z_ij       = tanh(code_ij * kCorrelationStep), |code_ij| <= 127
+// and the matrix is rebuilt from the partial correlations (always positive
+// definite, see covariance_codec.h).
+inline constexpr double kLogVarianceMin = -40.0;        // log2 of the smallest variance
+inline constexpr double kLogVarianceStep = 0.25;        // log2 units per code
+inline constexpr int kLogVarianceMaxCode = 255;         // largest variance 2^23.75
+inline constexpr double kCorrelationStep = 1.0 / 40.0;  // atanh units per code
+inline constexpr int kCorrelationMaxCode = 127;         // |z| <= tanh(127/40) = 0.99651
+constexpr size_t CovarianceBytes(size_t n) { return n + n * (n - 1) / 2; }
+
 // --- Payload layouts --------------------------------------------------------
-// EgoState: stamp i64 | session_start i64 | q_Gj_bj f32x4 (x y z w) |
-//   p_bj_in_Gj f64x3 | v_bj_in_Gj f32x3 | omega_bj_in_bj f32x3 |
-//   cov_theta f32x6 | cov_p f32x6 | cov_v f32x6 | flags u8 (bit0 degenerated) |
-//   count u8 | count x { observed id u8 | p_bk_in_bj f32x3 | cov f32x6 }
-inline constexpr size_t kEgoStateFixedBytes = 8 + 8 + 16 + 24 + 12 + 12 + 3 * 24 + 1 + 1;
-inline constexpr size_t kObservationBytes = 1 + 12 + 24;
-// GlobalExtrinsic: stamp i64 | g_in_Gi f32x3 | cov_g_in_Gi f32x6 | count u8 |
-//   count x { teammate id u8 | source u8 | q_Gi_Gj f32x4 | p_Gj_in_Gi f64x3 |
-//   covariance upper triangle f32x21 }
-inline constexpr size_t kGlobalExtrinsicFixedBytes = 8 + 12 + 24 + 1;
-inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 16 + 24 + 21 * 4;
+// EgoState: stamp_ns i64 | stamp_ns - session_start_ns i48 |
+//   bits u8 (0-1 q largest index, 2 degenerated, 3-7 observation count) |
+//   q_Gj_bj 3 x i16 | p_bj_in_Gj f32 x3 | v_bj_in_Gj f16 x3 | omega_bj_in_bj f16 x3 |
+//   cov_theta cov(3) | cov_p cov(3) | cov_v cov(3) |
+//   count x { observed id u8 | p_bk_in_bj 3 x i16 (2 mm) | cov(3) }
+inline constexpr size_t kEgoStateFixedBytes = 8 + 6 + 1 + 6 + 12 + 6 + 6 + 3 * CovarianceBytes(3);
+inline constexpr size_t kObservationBytes = 1 + 6 + CovarianceBytes(3);
+// GlobalExtrinsic: stamp i64 | g_in_Gi f32 x3 | cov_g_in_Gi cov(3) | count u8 |
+//   count x { teammate id u8 | bits u8 (0-1 q largest index, 2 source: 0 trajectory
+//   match, 1 graph) | q_Gi_Gj 3 x i16 | p_Gj_in_Gi f32 x3 | covariance cov(6) }
+inline constexpr size_t kGlobalExtrinsicFixedBytes = 8 + 12 + CovarianceBytes(3) + 1;
+inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 6 + 12 + CovarianceBytes(6);
 // TimeSync: target id u8 | kind u8 (0 request, 1 response) | t1 t2 t3 i64
 inline constexpr size_t kTimeSyncBytes = 1 + 1 + 3 * 8;
 
@@ -63,11 +89,13 @@ constexpr size_t GlobalExtrinsicPacketBytes(size_t num_entries) {
 }
 constexpr size_t TimeSyncPacketBytes() { return kPacketOverheadBytes + kTimeSyncBytes; }
 
-static_assert(kEgoStateFixedBytes == 154 && kObservationBytes == 37, "layout changed: update docs");
-static_assert(kExtrinsicEntryBytes == 126, "layout changed: update docs");
+static_assert(kEgoStateFixedBytes == 63 && kObservationBytes == 13, "layout changed: update docs");
+static_assert(kGlobalExtrinsicFixedBytes == 27 && kExtrinsicEntryBytes == 41,
+              "layout changed: update docs");
 static_assert(EgoStatePacketBytes(EgoStateMessage::kMaxObservations) <= kMaxPacketBytes);
 static_assert(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries) <= kMaxPacketBytes);
 static_assert(TimeSyncPacketBytes() <= kMaxPacketBytes);
+static_assert(EgoStateMessage::kMaxObservations < 32, "the count travels in 5 bits");
 static_assert(kMaxSwarmSize <= 255, "ids travel as one byte");
 
 }  // namespace swarmlio::net
