@@ -129,14 +129,17 @@ TEST_F(SwarmEndToEndTest, TeammatesKeepTheWallFacingAviaFromDrifting) {
 // to their time with the own IMU motion as a function of the current state
 // (factors/passive_observation_factor.h), they still hold the Avia. With the
 // motion treated as a known displacement (no attitude, bias and gravity
-// columns) the Avia diverged (43 m on the full scenario; docs/swarm.md).
+// columns) the Avia diverged (43 m on the full scenario; docs/swarm.md) and
+// this 36 s run ends at 0.31 m. The bound is 0.10 m: the run is sensitive to
+// small changes (0.028-0.062 m over the wire format's roundings and +-5 % on
+// the velocity covariance), all far from the defect.
 TEST_F(SwarmEndToEndTest, LateObservationsStillHoldTheWallFacingAvia) {
   std::vector<int> identified;
   const std::vector<double> late = Run(false, &identified, /*latency_s=*/0.4);
   ASSERT_EQ(late.size(), 3u);
   std::printf("[ figures  ] 0.4 s latency: position RMSE %.4f / %.4f / %.4f m\n", late[0],
               late[1], late[2]);
-  EXPECT_LT(late[0], 0.05);
+  EXPECT_LT(late[0], 0.10);
 }
 
 }  // namespace
