@@ -7,12 +7,12 @@
 //   net::DecodedPacket decoded;
 //   Status s = codec.Decode(packet.data(), packet.size(), &decoded);
 //
-// Decode never trusts its input. It checks, in order: size bounds, magic,
-// version, type, flags, sender id, payload length against the packet size,
-// the authentication tag (constant time), then every payload field: counts
-// against the per-type caps and the remaining bytes, ids in range and
-// distinct, no NaN/Inf, unit quaternions, non-negative variances, enum
-// values, and no trailing bytes. The first failure is returned as a Status
+// Decode never trusts its input. It checks, in order: size bounds, the
+// header (version, type, sender id), the authentication tag (constant time),
+// then every payload field (wire format version 3, docs/network.md §2-§3):
+// counts against the per-type caps and the remaining bytes, ids in range and
+// distinct, no NaN/Inf, every quantized code in its range, valid quaternion
+// encodings, flag bits, stamp overflow, and no trailing bytes. The first failure is returned as a Status
 // (DataLoss for malformed or unauthentic bytes, InvalidArgument for an
 // unsupported version or type) and `*packet` is left unchanged. Encode
 // applies the same field checks, so a packet that Encode produced always
