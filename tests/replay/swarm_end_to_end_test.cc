@@ -15,9 +15,7 @@
 
 #include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/swarm_replay.h"
-#include "swarmlio/sim/output_writer.h"
-#include "swarmlio/sim/scenario.h"
-#include "swarmlio/sim/simulator.h"
+#include "test_utils/simulated_swarm.h"
 
 namespace swarmlio::replay {
 namespace {
@@ -30,40 +28,10 @@ class SwarmEndToEndTest : public ::testing::Test {
     dir_ = new fs::path(fs::temp_directory_path() /
                         ("swarmlio_swarm_e2e_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
-    sim::Scenario scenario;
-    ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
-                                      "/configs/scenarios/wall_degenerate.yaml",
-                                  &scenario)
-                    .ok());
-    sim::SimulationConfig config = scenario.simulation_config();
-    config.duration_s = 36.0;
-    config.num_threads = 2;
-    std::vector<std::unique_ptr<sim::DroneOutputWriter>> writers(scenario.drones.size());
-    std::vector<sim::DroneSink*> sinks;
     manifest_ = new SwarmManifest();
-    manifest_->name = "wall_degenerate";
-    for (size_t i = 0; i < scenario.drones.size(); ++i) {
-      const sim::DroneConfig& d = scenario.drones[i];
-      const std::string stem = (*dir_ / d.name).string();
-      ASSERT_TRUE(sim::DroneOutputWriter::Open(stem + ".bag", stem + "_gt.txt",
-                                               sim::BagOptionsFor(scenario.bag, d.lidar.sensor),
-                                               &writers[i])
-                      .ok());
-      sinks.push_back(writers[i].get());
-      DroneInput input;
-      input.name = d.name;
-      input.bag_path = stem + ".bag";
-      input.lidar = d.lidar.sensor;
-      input.imu = d.imu.sensor;
-      input.bag.point_time_unit = d.lidar.sensor.timestamp_unit;
-      input.odometry = DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
-      input.odometry.imu_time_offset_s = d.imu.time_offset_s;  // as if calibrated
-      manifest_->drones.push_back(input);
-    }
-    sim::Simulator simulator(std::move(scenario.scene), scenario.drones, scenario.objects, config);
-    std::vector<sim::DroneStats> stats;
-    ASSERT_TRUE(simulator.Run(sinks, &stats).ok());
-    for (auto& w : writers) ASSERT_TRUE(w->Close().ok());
+    ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
+        std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/wall_degenerate.yaml",
+        "wall_degenerate", 36.0, *dir_, manifest_));
   }
   static void TearDownTestSuite() {
     std::error_code ec;

@@ -1,0 +1,67 @@
+// Test helper: simulates a scenario file into one bag and ground-truth file
+// per drone under `dir` and fills the replay manifest that reads them back,
+// with each drone's sensor presets, default odometry options and the IMU time
+// offset as if calibrated. Header-only; the test executable links swarmlio_sim
+// and swarmlio_replay.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "swarmlio/replay/manifest.h"
+#include "swarmlio/sim/output_writer.h"
+#include "swarmlio/sim/scenario.h"
+#include "swarmlio/sim/simulator.h"
+
+namespace swarmlio::testing {
+
+/// `scenario_path` simulated for `duration_s` seconds with 2 threads.
+inline ::testing::AssertionResult SimulateSwarm(const std::string& scenario_path,
+                                                const std::string& name,
+                                                double duration_s,
+                                                const std::filesystem::path& dir,
+                                                replay::SwarmManifest* manifest) {
+  sim::Scenario scenario;
+  const Status loaded = sim::LoadScenario(scenario_path, &scenario);
+  if (!loaded.ok()) return ::testing::AssertionFailure() << loaded.message();
+  sim::SimulationConfig config = scenario.simulation_config();
+  config.duration_s = duration_s;
+  config.num_threads = 2;
+  std::vector<std::unique_ptr<sim::DroneOutputWriter>> writers(scenario.drones.size());
+  std::vector<sim::DroneSink*> sinks;
+  manifest->name = name;
+  for (size_t i = 0; i < scenario.drones.size(); ++i) {
+    const sim::DroneConfig& d = scenario.drones[i];
+    const std::string stem = (dir / d.name).string();
+    const Status opened =
+        sim::DroneOutputWriter::Open(stem + ".bag", stem + "_gt.txt",
+                                     sim::BagOptionsFor(scenario.bag, d.lidar.sensor), &writers[i]);
+    if (!opened.ok()) return ::testing::AssertionFailure() << opened.message();
+    sinks.push_back(writers[i].get());
+    replay::DroneInput input;
+    input.name = d.name;
+    input.bag_path = stem + ".bag";
+    input.lidar = d.lidar.sensor;
+    input.imu = d.imu.sensor;
+    input.bag.point_time_unit = d.lidar.sensor.timestamp_unit;
+    input.odometry = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    input.odometry.imu_time_offset_s = d.imu.time_offset_s;  // as if calibrated
+    manifest->drones.push_back(input);
+  }
+  sim::Simulator simulator(std::move(scenario.scene), scenario.drones, scenario.objects, config);
+  std::vector<sim::DroneStats> stats;
+  const Status ran = simulator.Run(sinks, &stats);
+  if (!ran.ok()) return ::testing::AssertionFailure() << ran.message();
+  for (auto& w : writers) {
+    const Status closed = w->Close();
+    if (!closed.ok()) return ::testing::AssertionFailure() << closed.message();
+  }
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace swarmlio::testing
