@@ -333,7 +333,8 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       const PredictedTeammate j = Predict(m, so.time_compensation ? age : 0.0);
       const GlobalExtrinsic& T = x->teammate(o.drone_id);
       auto factor = std::make_unique<ActiveObservationFactor>(
-          o.p_bj_in_bi, j.p_bj_in_Gj, Regularized<3>(o.covariance_m2), Regularized<3>(j.cov_p), R_Gi_bi,
+          o.p_bj_in_bi, j.p_bj_in_Gj, Regularized<3>(o.covariance_m2) / so.observation_information_share,
+          Regularized<3>(j.cov_p), R_Gi_bi,
           T.R_Gi_Gj());
       const Eigen::Vector3d e = factor->Predict(x->ego, T) - o.p_bj_in_bi;
       const Eigen::Matrix3d S = factor->covariance();
@@ -362,7 +363,9 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       // the motion (dead_reckoning.h) when the history covers t_j, else the
       // constant-velocity shift p + v dt.
       ImuRetrodiction retrodiction;
-      const Eigen::Matrix3d Sigma_obs = Regularized<3>(p.cov);
+      // The observer fused the same measurement actively: this use takes its
+      // share of the information (SwarmOptions::observation_information_share).
+      const Eigen::Matrix3d Sigma_obs = Regularized<3>(p.cov) / so.observation_information_share;
       if (so.time_compensation) im.dead_reckoning.Retrodiction(p.stamp_ns, t_k, &retrodiction);
       auto factor = std::make_unique<PassiveObservationFactor>(
           p.p_bi_in_bj, so.time_compensation ? dt : 0.0, p.sender.q_Gj_bj.normalized().toRotationMatrix(),

@@ -1,5 +1,7 @@
 #include "swarmlio/teammate/observation.h"
 
+#include <cmath>
+
 namespace swarmlio::teammate {
 
 Eigen::Matrix3d ObservationCovariance(const Eigen::Vector3d& p_in_b,
@@ -13,9 +15,19 @@ Eigen::Matrix3d ObservationCovariance(const Eigen::Vector3d& p_in_b,
          lateral * lateral * (Eigen::Matrix3d::Identity() - along);
 }
 
-ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptions& options) {
+Eigen::Vector3d TapeCentroidInBody(const Eigen::Vector3d& u_in_bj, double a, double b) {
+  const double ux = u_in_bj.x(), uy = u_in_bj.y();
+  const double denominator = b * std::abs(ux) + a * std::abs(uy);
+  // Seen from straight above or below, the band shows no side face.
+  if (denominator <= 1e-9) return Eigen::Vector3d::Zero();
+  return (a * b / denominator) * Eigen::Vector3d(ux, uy, 0.0);
+}
+
+ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptions& options,
+                             const Eigen::Matrix3d* R_bi_bj) {
   ClusterCentre centre;
-  if (cluster.num_reflective_points >= options.min_reflective_points) {
+  const bool tape_only = cluster.num_reflective_points >= options.min_reflective_points;
+  if (tape_only) {
     centre.p_in_b = cluster.reflective_centroid_in_b;
     centre.time_offset_s = cluster.reflective_mean_time_offset_s;
   } else {
@@ -23,18 +35,27 @@ ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptio
     centre.time_offset_s = cluster.mean_time_offset_s;
   }
   const double range = centre.p_in_b.norm();
-  if (range > 0.0) centre.p_in_b += options.centroid_depth_offset_m * centre.p_in_b / range;
+  if (range <= 0.0) return centre;
+  const bool band_known = options.tape_half_length_m > 0.0 && options.tape_half_width_m > 0.0;
+  if (tape_only && band_known && R_bi_bj != nullptr) {
+    const Eigen::Vector3d u_in_bj = R_bi_bj->transpose() * (-centre.p_in_b / range);
+    centre.p_in_b -= *R_bi_bj * TapeCentroidInBody(u_in_bj, options.tape_half_length_m,
+                                                  options.tape_half_width_m);
+  } else {
+    centre.p_in_b += options.centroid_depth_offset_m * centre.p_in_b / range;
+  }
   return centre;
 }
 
 TeammateObservation MakeObservation(int drone_id, double stamp_s, const PointCluster& cluster,
                                     const Eigen::Vector3d& v_bj_in_bi,
-                                    const ObservationOptions& options) {
+                                    const ObservationOptions& options,
+                                    const Eigen::Matrix3d* R_bi_bj) {
   TeammateObservation out;
   out.drone_id = drone_id;
   out.stamp_s = stamp_s;
   out.num_points = cluster.num_points;
-  const ClusterCentre centre = EstimateCentre(cluster, options);
+  const ClusterCentre centre = EstimateCentre(cluster, options, R_bi_bj);
   out.capture_offset_s = centre.time_offset_s;
   Eigen::Vector3d p = centre.p_in_b;
   if (options.compensate_target_motion) p -= v_bj_in_bi * centre.time_offset_s;

@@ -57,4 +57,23 @@ bool OdometryHistory::StateAt(double stamp_s, double max_gap_s, double max_extra
   return true;
 }
 
+bool OdometryHistory::AttitudeAt(double stamp_s, double max_age_s,
+                                 Eigen::Quaterniond* q_Gj_bj) const {
+  if (messages_.empty()) return false;
+  auto after = std::lower_bound(
+      messages_.begin(), messages_.end(), stamp_s,
+      [](const TeammateOdometry& m, double s) { return m.stamp_s < s; });
+  const TeammateOdometry* nearest = after != messages_.end() ? &*after : nullptr;
+  if (after != messages_.begin()) {
+    const TeammateOdometry& before = *(after - 1);
+    if (nearest == nullptr ||
+        std::abs(before.stamp_s - stamp_s) < std::abs(nearest->stamp_s - stamp_s)) {
+      nearest = &before;
+    }
+  }
+  if (std::abs(nearest->stamp_s - stamp_s) > max_age_s) return false;
+  *q_Gj_bj = nearest->q_Gj_bj;
+  return true;
+}
+
 }  // namespace swarmlio::teammate

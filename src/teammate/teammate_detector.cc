@@ -102,7 +102,17 @@ void TeammateDetector::TrackTeammates(double stamp_s, const Eigen::Isometry3d& T
       tracker.UpdateOdometry(stamp_s, history, options_.teammate);
       continue;
     }
-    const ClusterCentre centre = EstimateCentre(cluster, options_.observation);
+    // The teammate's attitude relative to mine, from its broadcast through
+    // T_Gi_Gj, places the body origin behind the tape (observation.h).
+    Eigen::Quaterniond q_Gj_bj;
+    Eigen::Matrix3d R_bi_bj;
+    const bool attitude_known =
+        history.AttitudeAt(stamp_s, options_.teammate.max_odometry_age_s, &q_Gj_bj);
+    if (attitude_known) {
+      R_bi_bj = T_Gi_bi.linear().transpose() * tracker.R_Gi_Gj() * q_Gj_bj.toRotationMatrix();
+    }
+    const Eigen::Matrix3d* R_bi_bj_known = attitude_known ? &R_bi_bj : nullptr;
+    const ClusterCentre centre = EstimateCentre(cluster, options_.observation, R_bi_bj_known);
     tracker.UpdateLidar(stamp_s + centre.time_offset_s, T_Gi_bi * centre.p_in_b, history,
                         options_.teammate);
     Eigen::Vector3d v_in_Gi = tracker.filter().v();
@@ -110,7 +120,7 @@ void TeammateDetector::TrackTeammates(double stamp_s, const Eigen::Isometry3d& T
     if (cluster.centroid_in_b.norm() >= options_.observation.min_range_m) {
       result->observations.push_back(MakeObservation(id, stamp_s, cluster,
                                                      T_Gi_bi.linear().transpose() * v_in_Gi,
-                                                     options_.observation));
+                                                     options_.observation, R_bi_bj_known));
     }
     seen_teammates_.push_back(id);
   }

@@ -44,5 +44,24 @@ TEST(OdometryHistory, HermiteInterpolationIsExactForCubics) {
   EXPECT_FALSE(OdometryHistory().StateAt(1.0, 1.0, 1.0, &q, &w));
 }
 
+TEST(OdometryHistory, AttitudeOfTheNearestMessage) {
+  OdometryHistory h;
+  Eigen::Quaterniond q;
+  EXPECT_FALSE(h.AttitudeAt(1.0, 0.5, &q));
+  TeammateOdometry a = Message(1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  TeammateOdometry b = Message(2.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  b.q_Gj_bj = Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+  h.Add(a, 10.0);
+  h.Add(b, 10.0);
+  ASSERT_TRUE(h.AttitudeAt(1.4, 0.5, &q));
+  EXPECT_TRUE(q.isApprox(a.q_Gj_bj));
+  ASSERT_TRUE(h.AttitudeAt(1.6, 0.5, &q));
+  EXPECT_TRUE(q.isApprox(b.q_Gj_bj));
+  ASSERT_TRUE(h.AttitudeAt(2.4, 0.5, &q));
+  EXPECT_TRUE(q.isApprox(b.q_Gj_bj));
+  EXPECT_FALSE(h.AttitudeAt(2.6, 0.5, &q));  // too old
+  EXPECT_FALSE(h.AttitudeAt(0.4, 0.5, &q));
+}
+
 }  // namespace
 }  // namespace swarmlio::teammate

@@ -46,6 +46,14 @@ struct SwarmOptions {
   /// same estimate comes back with every broadcast, its error correlated in
   /// time [m/s^2] (0.02 m/s^2 ~ 0.12 deg of tilt).
   double gravity_alignment_sigma_m_s2 = 0.02;
+  /// Each mutual observation is fused twice in the swarm: actively by the
+  /// drone that made it and passively by the drone it saw. Each use takes
+  /// this share of its information (observation covariance / share), so that
+  /// the two filters together count the measurement about once when their
+  /// estimates meet again through later messages (information splitting, as
+  /// in split covariance intersection). 1 = both uses at full weight (the
+  /// paper). docs/swarm.md "Information sharing".
+  double observation_information_share = 0.5;
   /// Passive observations shift the own position by v (t_j - t_k); active
   /// ones predict j's broadcast state to the update time with its velocity
   /// and angular rate. Off: both taken as if made at the update time.
@@ -91,6 +99,8 @@ struct SwarmOptions {
       FieldSpec::Doc("fuse the teammates' broadcast gravity with the own (tilt of T_Gi_Gj)"));
     v("gravity_alignment_sigma_m_s2", gravity_alignment_sigma_m_s2,
       FieldSpec::Positive("m/s^2", "1-sigma added to a teammate's gravity covariance"));
+    v("observation_information_share", observation_information_share,
+      FieldSpec::InRange(0.01, 1.0, "", "share of a mutual observation's information per use (active, passive)"));
     v("time_compensation", time_compensation,
       FieldSpec::Doc("predict teammate states / shift passive observations to the update time"));
     v("max_message_age_s", max_message_age_s,

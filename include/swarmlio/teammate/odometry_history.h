@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <deque>
 
 #include "swarmlio/teammate/scan_types.h"
@@ -28,6 +29,9 @@ class OdometryHistory {
   /// when no message is close enough (see the file comment).
   bool StateAt(double stamp_s, double max_gap_s, double max_extrapolation_s,
                Eigen::Vector3d* p_bj_in_Gj, Eigen::Vector3d* v_bj_in_Gj) const;
+  /// Attitude R_Gj_bj of the message nearest to `stamp_s`; false when none is
+  /// within `max_age_s`.
+  bool AttitudeAt(double stamp_s, double max_age_s, Eigen::Quaterniond* q_Gj_bj) const;
 
  private:
   std::deque<TeammateOdometry> messages_;  // sorted by stamp
