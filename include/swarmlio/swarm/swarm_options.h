@@ -52,7 +52,9 @@ struct SwarmOptions {
   /// the two filters together count the measurement about once when their
   /// estimates meet again through later messages (information splitting, as
   /// in split covariance intersection). 1 = both uses at full weight (the
-  /// paper). docs/swarm.md "Information sharing".
+  /// paper). A drone whose last scan was degenerate uses 1: its teammates
+  /// skip observations involving it (skip_degenerate_teammates). docs/swarm.md
+  /// "Information sharing".
   double observation_information_share = 0.5;
   /// Passive observations shift the own position by v (t_j - t_k); active
   /// ones predict j's broadcast state to the update time with its velocity
