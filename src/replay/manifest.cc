@@ -27,6 +27,7 @@ struct DroneEntry {
   lio::OdometryOptions odometry;
   teammate::TeammateDetectorOptions teammate;
   swarm::SwarmOptions swarm;
+  TrueClock true_clock;
   Eigen::Vector3d p_G_in_W_m = Eigen::Vector3d::Zero();
   std::vector<double> q_W_G_xyzw = {0.0, 0.0, 0.0, 1.0};
 
@@ -48,6 +49,7 @@ struct DroneEntry {
     v("odometry", odometry);
     v("teammate", teammate);
     v("swarm", swarm);
+    v("true_clock", true_clock);
     v("p_G_in_W_m", p_G_in_W_m,
       FieldSpec::InRange(-1e7, 1e7, "m", "origin of G in a common world frame (plots only)"));
     v("q_W_G_xyzw", q_W_G_xyzw,
@@ -93,6 +95,18 @@ std::string Resolve(const std::filesystem::path& folder, const std::string& path
 
 }  // namespace
 
+int64_t TrueClock::ToDrone(int64_t true_ns) const {
+  const double origin_ns = origin_s * 1e9;
+  const double t_ns = static_cast<double>(true_ns) - origin_ns;
+  return std::llround(origin_ns + t_ns * (1.0 + drift_ppm * 1e-6) + offset_s * 1e9);
+}
+
+int64_t TrueClock::ToTrue(int64_t drone_ns) const {
+  const double origin_ns = origin_s * 1e9;
+  const double clock_ns = static_cast<double>(drone_ns) - origin_ns - offset_s * 1e9;
+  return std::llround(origin_ns + clock_ns / (1.0 + drift_ppm * 1e-6));
+}
+
 lio::OdometryOptions DefaultOdometryOptions(const LidarOptions& lidar, const ImuOptions& imu) {
   lio::OdometryOptions odometry = lio::OdometryOptionsFor(lidar);
   odometry.imu_init.acceleration_unit = imu.acceleration_unit == AccelerationUnit::kStandardGravity
@@ -124,6 +138,7 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     d.ground_truth_path = Resolve(folder, e.ground_truth);
     d.ground_truth_frame = e.ground_truth_frame;
     d.bag = e.bag_topics;
+    d.true_clock = e.true_clock;
     d.p_G_in_W_m = e.p_G_in_W_m;
     d.R_W_G = Eigen::Quaterniond(e.q_W_G_xyzw[3], e.q_W_G_xyzw[0], e.q_W_G_xyzw[1], e.q_W_G_xyzw[2])
                   .normalized()

@@ -62,13 +62,17 @@ Status SwarmReplay::SetUpNetwork(const ReplayOptions& options) {
   return Status::Ok();
 }
 
-Status SwarmReplay::Broadcast(int drone) {
+Status SwarmReplay::Broadcast(int drone, int64_t now_ns) {
   outbox_.clear();
   runners_[drone]->TakeMessages(&outbox_);
   for (const net::SwarmMessage& m : outbox_) {
-    const int64_t stamp_ns = std::holds_alternative<net::EgoStateMessage>(m)
+    // A state leaves at its scan end (processing taken as instantaneous);
+    // everything else when it was produced, at the record just consumed.
+    // The network runs on true time (the drones' clocks differ, TrueClock).
+    const int64_t local_ns = std::holds_alternative<net::EgoStateMessage>(m)
                                  ? std::get<net::EgoStateMessage>(m).stamp_ns
-                                 : runners_[drone]->scans().back().stamp_ns;
+                                 : now_ns;
+    const int64_t stamp_ns = runners_[drone]->input().true_clock.ToTrue(local_ns);
     SWARMLIO_RETURN_IF_ERROR(channels_[drone]->Send(stamp_ns, net::kBroadcastId, m));
     ++traffic_[drone].sent;
   }
@@ -88,11 +92,15 @@ Status SwarmReplay::Run(const ReplayOptions& options) {
   }
   std::vector<bool> failed(runners_.size(), false);
   while (true) {
+    // The drone whose next record comes first in true time.
     int best = -1;
+    int64_t best_true_ns = 0;
     for (size_t i = 0; i < runners_.size(); ++i) {
       if (failed[i] || !runners_[i]->has_next()) continue;
-      if (best < 0 || runners_[i]->next_stamp_ns() < runners_[best]->next_stamp_ns()) {
+      const int64_t true_ns = runners_[i]->input().true_clock.ToTrue(runners_[i]->next_stamp_ns());
+      if (best < 0 || true_ns < best_true_ns) {
         best = static_cast<int>(i);
+        best_true_ns = true_ns;
       }
     }
     if (best < 0 || runners_[best]->next_stamp_ns() > limit_ns) break;
@@ -100,9 +108,10 @@ Status SwarmReplay::Run(const ReplayOptions& options) {
     if (!channels_.empty()) {
       // What reached this drone by the stamp of its next record.
       inbox.clear();
-      const Status polled = channels_[best]->Poll(progress.stamp_ns, &inbox);
+      const Status polled = channels_[best]->Poll(best_true_ns, &inbox);
       if (!polled.ok() && first_error.ok()) first_error = polled;
-      for (const net::ReceivedMessage& m : inbox) {
+      for (net::ReceivedMessage& m : inbox) {
+        m.arrival_ns = runners_[best]->input().true_clock.ToDrone(m.arrival_ns);
         ++traffic_[best].received;
         if (std::holds_alternative<net::EgoStateMessage>(m.message)) ++traffic_[best].ego_states;
         runners_[best]->Deliver(m);
@@ -114,7 +123,7 @@ Status SwarmReplay::Run(const ReplayOptions& options) {
       if (first_error.ok()) first_error = status;
     }
     if (!channels_.empty()) {
-      const Status sent = Broadcast(best);
+      const Status sent = Broadcast(best, progress.stamp_ns);
       if (!sent.ok() && first_error.ok()) first_error = sent;
     }
     ++progress.records;

@@ -125,6 +125,9 @@ std::string ReplayManifestYaml(const Scenario& s, const Simulator& sim) {
     os << "    p_G_in_W_m: " << Vec(T.p_b_in_W) << "\n";
     os << "    q_W_G_xyzw: " << Quat(Eigen::Quaterniond(T.R_W_b)) << "\n";
     os << "    ground_truth: " << d.name << "_gt_tum.txt\n";
+    os << "    # the drone's clock (truth, for packet delivery in the replay only)\n";
+    os << "    true_clock: {offset_s: " << d.clock_offset_s << ", drift_ppm: " << d.clock_drift_ppm
+       << ", origin_s: " << sim.config().stamp_origin_s << "}\n";
     os << Indented(config::DumpOptions(lidar, "lidar"), "    ");
     os << Indented(config::DumpOptions(d.imu.sensor, "imu"), "    ");
     os << "    odometry:\n";

@@ -60,6 +60,10 @@ Status DroneEstimator::Create(int self_id, const DroneEstimatorOptions& options,
   std::unique_ptr<DroneEstimator> out(new DroneEstimator(self_id, options, lidar));
   SWARMLIO_RETURN_IF_ERROR(lio::Odometry::Create(options.odometry, lidar, &out->odometry_));
   out->detector_ = std::make_unique<teammate::TeammateDetector>(self_id, options.teammate);
+  if (options.swarm.synchronize_clocks) {
+    SWARMLIO_RETURN_IF_ERROR(
+        net::ClockSync::Create(self_id, options.swarm.clock_sync, &out->impl_->clock_sync));
+  }
   out->odometry_->SetHooks(out.get());
   *estimator = std::move(out);
   return Status::Ok();
@@ -96,12 +100,14 @@ void Collect(lio::Odometry* odometry, std::vector<lio::ScanOutput>* scratch,
 
 Status DroneEstimator::AddImu(const ImuSample& sample) {
   if (sample.angular_velocity_rad_s.allFinite()) impl_->last_gyro = sample.angular_velocity_rad_s;
+  impl_->now_ns = std::max(impl_->now_ns, sample.stamp_ns);
   const Status status = odometry_->AddImu(sample);
   Collect(odometry_.get(), &impl_->odometry_outputs, &impl_->parts, &impl_->outputs);
   return status;
 }
 
 Status DroneEstimator::AddScan(const LidarScan& scan) {
+  impl_->now_ns = std::max(impl_->now_ns, scan.stamp_ns);
   const Status status = odometry_->AddScan(scan);
   Collect(odometry_.get(), &impl_->odometry_outputs, &impl_->parts, &impl_->outputs);
   return status;
@@ -119,9 +125,25 @@ void DroneEstimator::PopOutputs(std::vector<DroneOutput>* outputs) {
 }
 
 void DroneEstimator::PopMessages(std::vector<net::SwarmMessage>* messages) {
-  for (net::SwarmMessage& m : impl_->messages) messages->push_back(std::move(m));
-  impl_->messages.clear();
+  Impl& im = *impl_;
+  for (net::SwarmMessage& m : im.messages) messages->push_back(std::move(m));
+  im.messages.clear();
+  if (im.clock_sync == nullptr || im.now_ns == std::numeric_limits<int64_t>::min()) return;
+  // Clock synchronisation, stamped with the send time: answers to the
+  // teammates' requests (t3), then the own requests that are due (t1).
+  for (const auto& [request, arrival_ns] : im.sync_requests) {
+    net::TimeSyncMessage reply;
+    if (im.clock_sync->HandleMessage(request, arrival_ns, std::max(im.now_ns, arrival_ns), &reply)) {
+      messages->push_back(reply);
+    }
+  }
+  im.sync_requests.clear();
+  std::vector<net::TimeSyncMessage> requests;
+  im.clock_sync->DueRequests(im.now_ns, &requests);
+  for (const net::TimeSyncMessage& r : requests) messages->push_back(r);
 }
+
+const net::ClockSync* DroneEstimator::clock_sync() const { return impl_->clock_sync.get(); }
 
 void DroneEstimator::SelectDetectorPoints(const LidarScan& raw, int64_t t_k, const SwarmState& x,
                                           const Eigen::Matrix3d& R_imu_lidar,

@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
+#include <limits>
+#include <memory>
 #include <map>
 #include <utility>
 #include <vector>
@@ -63,6 +65,12 @@ struct DroneEstimator::Impl {
   std::vector<lio::ScanOutput> odometry_outputs;
   std::vector<DroneOutput> outputs;
   std::vector<net::SwarmMessage> messages;
+  // Clock synchronisation: the requests to answer when the messages are
+  // taken (t3 = send time), and the newest sensor stamp ("now").
+  std::unique_ptr<net::ClockSync> clock_sync;
+  std::vector<std::pair<net::TimeSyncMessage, int64_t>> sync_requests;  // with arrival
+  std::map<int, int64_t> clock_sessions;  // session_start_ns each teammate's clock belongs to
+  int64_t now_ns = std::numeric_limits<int64_t>::min();
 };
 
 }  // namespace swarmlio::swarm

@@ -11,6 +11,10 @@
 namespace swarmlio::swarm {
 namespace {
 
+// Requests from teammates waiting for their answer (a burst of every
+// teammate fits; beyond it, a flood is dropped).
+constexpr size_t kMaxPendingSyncRequests = 256;
+
 using internal::Finite;
 using internal::PendingMutual;
 using internal::PendingPassive;
@@ -24,6 +28,19 @@ using internal::TeammateInfo;
 
 Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   ++counters_.messages_received;
+  if (const auto* t = std::get_if<net::TimeSyncMessage>(&received.message)) {
+    if (impl_->clock_sync == nullptr || t->sender_id == self_id_ || t->target_id != self_id_) {
+      ++counters_.messages_ignored;
+      return Status::Ok();
+    }
+    if (t->is_response) {
+      net::TimeSyncMessage unused;
+      impl_->clock_sync->HandleMessage(*t, received.arrival_ns, received.arrival_ns, &unused);
+    } else if (impl_->sync_requests.size() < kMaxPendingSyncRequests) {
+      impl_->sync_requests.emplace_back(*t, received.arrival_ns);  // answered in PopMessages
+    }
+    return Status::Ok();
+  }
   if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&received.message)) {
     if (g->sender_id == self_id_ || g->sender_id < 0) {
       ++counters_.messages_ignored;
@@ -49,10 +66,28 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
     }
     return Status::Ok();
   }
-  const auto* m = std::get_if<net::EgoStateMessage>(&received.message);
-  if (m == nullptr || m->sender_id == self_id_ || m->sender_id < 0 || !Finite(*m)) {
+  const auto* received_state = std::get_if<net::EgoStateMessage>(&received.message);
+  if (received_state == nullptr || received_state->sender_id == self_id_ ||
+      received_state->sender_id < 0 || !Finite(*received_state)) {
     ++counters_.messages_ignored;
     return Status::Ok();
+  }
+  // j's stamps on the own clock; its states wait until its offset is known.
+  net::EgoStateMessage local_state = *received_state;
+  const net::EgoStateMessage* m = &local_state;
+  if (impl_->clock_sync != nullptr) {
+    // A new session (j rebooted): its clock may have stepped, start over.
+    const auto [session, inserted] =
+        impl_->clock_sessions.emplace(m->sender_id, m->session_start_ns);
+    if (!inserted && session->second != m->session_start_ns) {
+      session->second = m->session_start_ns;
+      impl_->clock_sync->RemoveTeammate(m->sender_id);
+    }
+    impl_->clock_sync->AddTeammate(m->sender_id, received.arrival_ns);
+    if (!impl_->clock_sync->ToLocal(m->sender_id, received_state->stamp_ns, &local_state.stamp_ns)) {
+      ++counters_.messages_unsynchronized;
+      return Status::Ok();
+    }
   }
   TeammateInfo& info = impl_->teammates[m->sender_id];
   if (info.have_message && m->session_start_ns != info.session_start_ns) {

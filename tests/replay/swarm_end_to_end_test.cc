@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -108,6 +109,63 @@ TEST_F(SwarmEndToEndTest, LateObservationsStillHoldTheWallFacingAvia) {
   std::printf("[ figures  ] 0.4 s latency: position RMSE %.4f / %.4f / %.4f m\n", late[0],
               late[1], late[2]);
   EXPECT_LT(late[0], 0.10);
+}
+
+// The same flight with the drones' clocks 0.5 s apart and drifting (the
+// live-swarm fault of docs/network.md): each drone estimates its teammates'
+// offsets from TimeSync exchanges and maps their stamps onto its own clock,
+// so the Avia is held as with agreeing clocks, and every offset is known
+// within 2 ms. Taking the stamps as they come (synchronize_clocks off), the
+// Avia's observations are half a second off; on indoor_3uav that tripled
+// the Avia's error and lost a pair (docs/results.md).
+TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("swarmlio_swarm_clock_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  SwarmManifest manifest;
+  const std::vector<double> offsets_s = {0.0, 0.5, -0.5};
+  const std::vector<double> drifts_ppm = {0.0, 30.0, -20.0};
+  ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
+      std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/wall_degenerate.yaml",
+      "wall_degenerate_clocks", 36.0, dir, &manifest, [&](sim::Scenario* s) {
+        for (size_t i = 0; i < s->drones.size(); ++i) {
+          s->drones[i].clock_offset_s = offsets_s[i];
+          s->drones[i].clock_drift_ppm = drifts_ppm[i];
+        }
+      }));
+  std::unique_ptr<SwarmReplay> run;
+  ASSERT_TRUE(SwarmReplay::Create(manifest, &run).ok());
+  ASSERT_TRUE(run->Run(ReplayOptions()).ok());
+  ASSERT_EQ(run->num_drones(), 3);
+  for (int i = 0; i < 3; ++i) {
+    const DroneRunner& d = run->drone(i);
+    EXPECT_EQ(d.identifications().size(), 2u) << d.input().name;
+    ASSERT_FALSE(d.scans().empty());
+    const int64_t t_last = d.scans().back().stamp_ns;
+    const net::ClockSync* sync = d.estimator().clock_sync();
+    ASSERT_NE(sync, nullptr);
+    for (int j = 0; j < 3; ++j) {
+      if (j == i) continue;
+      const int64_t truth_ns =
+          manifest.drones[j].true_clock.ToDrone(manifest.drones[i].true_clock.ToTrue(t_last)) -
+          t_last;
+      const net::ClockOffsetEstimate estimate = sync->Estimate(j, t_last);
+      ASSERT_TRUE(estimate.valid) << i << " -> " << j;
+      std::printf("[ figures  ] %s -> %s: clock offset %.4f s, error %.3f ms\n",
+                  d.input().name.c_str(), manifest.drones[j].name.c_str(), 1e-9 * truth_ns,
+                  1e-6 * static_cast<double>(estimate.offset_ns - truth_ns));
+      EXPECT_LT(std::abs(estimate.offset_ns - truth_ns), 2'000'000) << i << " -> " << j;
+    }
+  }
+  ConsistencyStats avia;
+  ASSERT_TRUE(EvaluateConsistency(run->drone(0).scans(), run->drone(0).bag_ground_truth(), 0.05,
+                                  &avia)
+                  .ok());
+  std::printf("[ figures  ] wall-facing Avia with clocks 0.5 s apart: position RMSE %.4f m\n",
+              avia.position_rmse_m);
+  EXPECT_LT(avia.position_rmse_m, 0.05);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
 }
 
 }  // namespace

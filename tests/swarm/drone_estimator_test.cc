@@ -47,6 +47,9 @@ DroneEstimatorOptions OptionsFor(const sim::DroneConfig& d) {
   DroneEstimatorOptions o;
   o.odometry = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
   o.odometry.imu_time_offset_s = d.imu.time_offset_s;
+  // The sinks below hand over the teammate's states stamped on one clock
+  // without TimeSync exchanges; clock synchronisation has its own test.
+  o.swarm.synchronize_clocks = false;
   return o;
 }
 
@@ -86,6 +89,88 @@ TEST(DroneEstimator, IgnoresOwnForeignTypedAndNonFiniteMessages) {
   EXPECT_TRUE(e->AddMessage(sync).ok());
   EXPECT_EQ(e->counters().messages_received, 3);
   EXPECT_EQ(e->counters().messages_ignored, 3);
+}
+
+// A teammate's states wait for its clock offset; the TimeSync requests and
+// answers leave with the send time (the newest sensor stamp).
+TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
+  sim::Scenario scenario = IndoorScenario();
+  ASSERT_FALSE(scenario.drones.empty());
+  const sim::DroneConfig& d = scenario.drones[0];
+  DroneEstimatorOptions o = OptionsFor(d);
+  o.swarm.synchronize_clocks = true;
+  std::unique_ptr<DroneEstimator> e;
+  ASSERT_TRUE(DroneEstimator::Create(0, o, d.lidar.sensor, &e).ok());
+  const int64_t t0 = 1'000'000'000'000;  // 1000 s on the own clock
+  const int64_t offset = 500'000'000;    // the teammate's clock is 0.5 s ahead
+  ImuSample imu;
+  imu.stamp_ns = t0;
+  imu.linear_acceleration = Eigen::Vector3d(0, 0, 9.81);
+  ASSERT_TRUE(e->AddImu(imu).ok());
+
+  net::EgoStateMessage state;
+  state.sender_id = 1;
+  state.stamp_ns = t0 + offset;
+  net::ReceivedMessage received;
+  received.arrival_ns = t0;
+  received.message = state;
+  ASSERT_TRUE(e->AddMessage(received).ok());
+  EXPECT_EQ(e->counters().messages_unsynchronized, 1);
+
+  std::vector<net::SwarmMessage> out;
+  e->PopMessages(&out);
+  ASSERT_EQ(out.size(), 1u);
+  const auto* request = std::get_if<net::TimeSyncMessage>(&out[0]);
+  ASSERT_NE(request, nullptr);
+  EXPECT_FALSE(request->is_response);
+  EXPECT_EQ(request->target_id, 1);
+  EXPECT_EQ(request->t1_ns, t0);
+
+  // The teammate answers after 1 ms each way and 0.1 ms of turnaround.
+  net::TimeSyncMessage response = *request;
+  response.sender_id = 1;
+  response.target_id = 0;
+  response.is_response = true;
+  response.t2_ns = request->t1_ns + 1'000'000 + offset;
+  response.t3_ns = response.t2_ns + 100'000;
+  received.arrival_ns = t0 + 2'100'000;
+  received.message = response;
+  ASSERT_TRUE(e->AddMessage(received).ok());
+  ASSERT_NE(e->clock_sync(), nullptr);
+  const net::ClockOffsetEstimate estimate = e->clock_sync()->Estimate(1, t0);
+  ASSERT_TRUE(estimate.valid);
+  EXPECT_EQ(estimate.offset_ns, offset);
+
+  // Now the state is used (its stamp mapped onto the own clock).
+  state.stamp_ns = t0 + offset + 100'000'000;
+  received.arrival_ns = t0 + 100'000'000;
+  received.message = state;
+  ASSERT_TRUE(e->AddMessage(received).ok());
+  EXPECT_EQ(e->counters().messages_unsynchronized, 1);
+
+  // A request from the teammate is answered when the messages are taken:
+  // t2 = its arrival, t3 = the newest sensor stamp.
+  net::TimeSyncMessage theirs;
+  theirs.sender_id = 1;
+  theirs.target_id = 0;
+  theirs.t1_ns = t0 + offset + 200'000'000;
+  received.arrival_ns = t0 + 201'000'000;
+  received.message = theirs;
+  ASSERT_TRUE(e->AddMessage(received).ok());
+  imu.stamp_ns = t0 + 205'000'000;
+  ASSERT_TRUE(e->AddImu(imu).ok());
+  out.clear();
+  e->PopMessages(&out);
+  const net::TimeSyncMessage* reply = nullptr;
+  for (const net::SwarmMessage& m : out) {
+    const auto* t = std::get_if<net::TimeSyncMessage>(&m);
+    if (t != nullptr && t->is_response) reply = t;
+  }
+  ASSERT_NE(reply, nullptr);
+  EXPECT_EQ(reply->target_id, 1);
+  EXPECT_EQ(reply->t1_ns, theirs.t1_ns);
+  EXPECT_EQ(reply->t2_ns, t0 + 201'000'000);
+  EXPECT_EQ(reply->t3_ns, t0 + 205'000'000);
 }
 
 // Feeds the observer's sensor data and the teammate's broadcasts in time order.

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -20,15 +21,16 @@
 
 namespace swarmlio::testing {
 
-/// `scenario_path` simulated for `duration_s` seconds with 2 threads.
-inline ::testing::AssertionResult SimulateSwarm(const std::string& scenario_path,
-                                                const std::string& name,
-                                                double duration_s,
-                                                const std::filesystem::path& dir,
-                                                replay::SwarmManifest* manifest) {
+/// `scenario_path` simulated for `duration_s` seconds with 2 threads;
+/// `edit`, when given, changes the loaded scenario first.
+inline ::testing::AssertionResult SimulateSwarm(
+    const std::string& scenario_path, const std::string& name, double duration_s,
+    const std::filesystem::path& dir, replay::SwarmManifest* manifest,
+    const std::function<void(sim::Scenario*)>& edit = nullptr) {
   sim::Scenario scenario;
   const Status loaded = sim::LoadScenario(scenario_path, &scenario);
   if (!loaded.ok()) return ::testing::AssertionFailure() << loaded.message();
+  if (edit) edit(&scenario);
   sim::SimulationConfig config = scenario.simulation_config();
   config.duration_s = duration_s;
   config.num_threads = 2;
@@ -51,6 +53,9 @@ inline ::testing::AssertionResult SimulateSwarm(const std::string& scenario_path
     input.bag.point_time_unit = d.lidar.sensor.timestamp_unit;
     input.odometry = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
     input.odometry.imu_time_offset_s = d.imu.time_offset_s;  // as if calibrated
+    input.true_clock.offset_s = d.clock_offset_s;  // packet delivery only
+    input.true_clock.drift_ppm = d.clock_drift_ppm;
+    input.true_clock.origin_s = config.stamp_origin_s;
     manifest->drones.push_back(input);
   }
   sim::Simulator simulator(std::move(scenario.scene), scenario.drones, scenario.objects, config);

@@ -124,8 +124,12 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
         m.extrinsic_end_deg = e_deg;
         m.extrinsic_max_m = std::max(m.extrinsic_max_m, e_m);
         m.extrinsic_max_deg = std::max(m.extrinsic_max_deg, e_deg);
+        // j's ground truth is stamped in j's clock: the same true instant.
+        const replay::TrueClock& clock_j = run.drone(r.drone_id).input().true_clock;
+        const double t_j = StampSeconds(clock_j.ToDrone(d.input().true_clock.ToTrue(s.stamp_ns)));
         Eigen::Vector3d p_true_in_Gj;
-        if (r.have_pose && has_truth[r.drone_id] && PositionAt(truth[r.drone_id], t, &p_true_in_Gj)) {
+        if (r.have_pose && has_truth[r.drone_id] &&
+            PositionAt(truth[r.drone_id], t_j, &p_true_in_Gj)) {
           const double err = (r.p_bj_in_Gi - T_true * p_true_in_Gj).norm();
           m.relative_rmse_m += err * err;
           ++m.relative_samples;
@@ -162,13 +166,30 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
           m.initial_error_deg =
               RotationDeg(T_true.linear().transpose() * e.initial_T_Gi_Gj.R_Gi_Gj());
           if (has_truth[i] && has_truth[j]) {
-            // Ground-truth stamps are in each drone's clock, like its bag.
+            // Ground-truth stamps are in each drone's clock, like its bag:
+            // j's excitation start moved to i's clock.
+            const double start_j_s = ExcitationStart(truth[j]);
+            const int64_t start_j_in_i_ns = d.input().true_clock.ToDrone(
+                run.drone(j).input().true_clock.ToTrue(std::llround(start_j_s * 1e9)));
             m.since_excitation_s = StampSeconds(e.stamp_ns) -
-                                   std::max(ExcitationStart(truth[i]), ExcitationStart(truth[j]));
+                                   std::max(ExcitationStart(truth[i]), StampSeconds(start_j_in_i_ns));
           }
         }
       }
       if (m.relative_samples > 0) m.relative_rmse_m = std::sqrt(m.relative_rmse_m / m.relative_samples);
+      // Clock offset of j as i estimated it at its last scan, against the truth.
+      const int64_t t_last = scans.back().stamp_ns;
+      m.clock_offset_true_ms =
+          1e-6 * static_cast<double>(run.drone(j).input().true_clock.ToDrone(
+                                         d.input().true_clock.ToTrue(t_last)) -
+                                     t_last);
+      if (const net::ClockSync* sync = d.estimator().clock_sync()) {
+        const net::ClockOffsetEstimate estimate = sync->Estimate(j, t_last);
+        if (estimate.valid) {
+          m.clock_offset_error_ms =
+              1e-6 * static_cast<double>(estimate.offset_ns) - m.clock_offset_true_ms;
+        }
+      }
       pairs->push_back(m);
     }
   }
@@ -211,13 +232,15 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
   std::ofstream csv((dir / "swarm_pairs.csv").string());
   csv << "observer,teammate,identified,identification_s,since_excitation_s,extrinsic_end_m,"
          "extrinsic_end_deg,extrinsic_max_m,extrinsic_max_deg,relative_rmse_m,active_fused,"
-         "passive_fused,initial_error_m,initial_error_deg\n";
+         "passive_fused,initial_error_m,initial_error_deg,clock_offset_true_ms,"
+         "clock_offset_error_ms\n";
   for (const PairMetrics& m : *pairs) {
     csv << m.observer << "," << m.teammate << "," << (m.identified ? 1 : 0) << ","
         << std::setprecision(6) << m.identification_s << "," << m.since_excitation_s << ","
         << m.extrinsic_end_m << "," << m.extrinsic_end_deg << "," << m.extrinsic_max_m << ","
         << m.extrinsic_max_deg << "," << m.relative_rmse_m << "," << m.active_fused << ","
-        << m.passive_fused << "," << m.initial_error_m << "," << m.initial_error_deg << "\n";
+        << m.passive_fused << "," << m.initial_error_m << "," << m.initial_error_deg << ","
+        << m.clock_offset_true_ms << "," << m.clock_offset_error_ms << "\n";
   }
   std::ofstream mdfile((dir / "swarm.md").string());
   mdfile << *markdown;

@@ -6,6 +6,7 @@
 // plus a plot of the extrinsic error over time. Tool-side: writes files.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,10 @@ struct PairMetrics {
   int relative_samples = 0;
   int active_fused = 0;
   int passive_fused = 0;
+  /// The observer's estimate of the teammate's clock offset at its last scan
+  /// minus the truth (TrueClock of the manifest) [ms]; NaN when not estimated.
+  double clock_offset_error_ms = std::nan("");
+  double clock_offset_true_ms = 0.0;  // teammate clock - observer clock [ms]
 };
 
 /// Writes the swarm outputs into `output_dir`; `truth_known`: the manifest

@@ -43,6 +43,31 @@ namespace swarmlio::replay {
 ///   kOther: another frame (mocap, simulator world), declared
 enum class GroundTruthFrame { kAuto, kG, kOther };
 
+/// How a drone's clock relates to the true time of a simulated run (YAML
+/// `true_clock:` of a drone entry; the simulator writes it): the drone stamps
+/// true time t as origin_s + t (1 + drift_ppm 1e-6) + offset_s. The replay
+/// uses it only to deliver packets on one time line; the estimators never see
+/// it (they estimate the offsets, swarm.synchronize_clocks). Absent: the
+/// drones' clocks agree.
+struct TrueClock {
+  double offset_s = 0.0;     // drone clock - true time at t = 0 [s]
+  double drift_ppm = 0.0;    // drone clock rate - 1 [ppm]
+  double origin_s = 1000.0;  // stamp of true time 0 on a drift-free, offset-free clock [s]
+
+  /// Stamp on this clock of the true time `true_ns` (both int64 ns), and back.
+  int64_t ToDrone(int64_t true_ns) const;
+  int64_t ToTrue(int64_t drone_ns) const;
+
+  template <class V>
+  void VisitFields(V&& v) {
+    using config::FieldSpec;
+    v("offset_s", offset_s, FieldSpec::InRange(-1e6, 1e6, "s", "drone clock - true time at t = 0"));
+    v("drift_ppm", drift_ppm, FieldSpec::InRange(-1e4, 1e4, "ppm", "drone clock rate - 1"));
+    v("origin_s", origin_s, FieldSpec::InRange(0.0, 1e10, "s", "stamp of true time 0"));
+  }
+  std::string Validate() const { return config::ValidateFields(*this); }
+};
+
 struct DroneInput {
   std::string name;
   std::string bag_path;           // resolved (relative to the manifest folder)
@@ -54,6 +79,7 @@ struct DroneInput {
   lio::OdometryOptions odometry;
   teammate::TeammateDetectorOptions teammate;  // YAML `teammate:` of the drone entry
   swarm::SwarmOptions swarm;                   // YAML `swarm:` of the drone entry
+  TrueClock true_clock;                        // simulation truth, packet delivery only
   /// Where the drone's global frame G lies in a common world frame W, only
   /// for drawing all drones in one top view (identity when unknown).
   Eigen::Matrix3d R_W_G = Eigen::Matrix3d::Identity();

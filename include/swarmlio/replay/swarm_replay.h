@@ -5,8 +5,10 @@
 // SimulatedNetwork behind the net::Transport interface a UDP transport will
 // implement): after every scan a drone broadcasts its EgoStateMessage, and
 // before each of its records it polls what has arrived by that record's stamp.
-// The network's clock is the recorded stamps (drone clock offsets are not
-// modelled in delivery). Every drone is a swarm::DroneEstimator: what arrives
+// The network runs on true time: each drone's stamps are mapped through its
+// manifest TrueClock (offset, drift; identity when absent), packets arrive on
+// the receiver's clock, and the drones synchronise their clocks themselves
+// (swarm.synchronize_clocks). Every drone is a swarm::DroneEstimator: what arrives
 // is delivered to it, what it produces is broadcast. single_agent (the
 // ablation, the paper's FAST-LIO2 column) fuses no mutual observation;
 // messages still flow, so teammates are identified and reported through
@@ -81,7 +83,7 @@ class SwarmReplay {
   SwarmManifest manifest_;
   std::vector<std::unique_ptr<DroneRunner>> runners_;
   Status SetUpNetwork(const ReplayOptions& options);
-  Status Broadcast(int drone);
+  Status Broadcast(int drone, int64_t now_ns);
   std::vector<net::SwarmMessage> outbox_;
 
   std::unique_ptr<net::SimulatedNetwork> network_;

@@ -30,6 +30,7 @@
 
 #include "swarmlio/common/status.h"
 #include "swarmlio/lio/odometry.h"
+#include "swarmlio/net/clock_sync.h"
 #include "swarmlio/net/message_channel.h"
 #include "swarmlio/net/messages.h"
 #include "swarmlio/sensors/lidar_options.h"
@@ -87,6 +88,7 @@ struct DroneEstimatorCounters {
   int64_t messages_received = 0;
   int64_t messages_ignored = 0;   // own, unknown type, non-finite, or stale
   int64_t teammate_restarts = 0;  // session_start changed
+  int64_t messages_unsynchronized = 0;  // states of a teammate whose clock offset is not known yet
   int64_t identifications = 0;
   int64_t teammates_removed = 0;
   int64_t active_fused = 0;
@@ -114,8 +116,13 @@ class DroneEstimator : public lio::ScanStageHooks {
   void SetFusion(bool fuse) { fusion_enabled_ = fuse; }
 
   void PopOutputs(std::vector<DroneOutput>* outputs);
-  /// Messages to broadcast, produced since the last call (one EgoStateMessage per scan).
+  /// Messages to broadcast, produced since the last call (one EgoStateMessage
+  /// per scan, the extrinsics, the clock-synchronisation requests and
+  /// responses). Send them now: the TimeSync stamps are the newest sensor
+  /// stamp given to this estimator (the driver's "now" on this drone's clock).
   void PopMessages(std::vector<net::SwarmMessage>* messages);
+  /// Clock synchronisation with the teammates (null when synchronize_clocks is off).
+  const net::ClockSync* clock_sync() const;
 
   int self_id() const { return self_id_; }
   const lio::Odometry& odometry() const { return *odometry_; }

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "swarmlio/config/option_fields.h"
+#include "swarmlio/net/clock_sync.h"
 
 namespace swarmlio::swarm {
 
@@ -60,6 +61,13 @@ struct SwarmOptions {
   /// ones predict j's broadcast state to the update time with its velocity
   /// and angular rate. Off: both taken as if made at the update time.
   bool time_compensation = true;
+  /// Estimate each teammate's clock offset from TimeSync exchanges (NTP-style,
+  /// net/clock_sync.h) and map every stamp it sends onto the own clock; a
+  /// teammate's states are not used before its offset is known (about one
+  /// burst, burst_requests x burst_period_s). Off: remote stamps are taken as
+  /// own-clock stamps (clocks synchronised outside, e.g. by PTP or chrony).
+  bool synchronize_clocks = true;
+  net::ClockSyncOptions clock_sync;
   /// Teammate messages older than this at the update time are not used [s].
   double max_message_age_s = 0.5;
   /// A teammate neither seen nor heard for this long leaves the state [s].
@@ -105,6 +113,9 @@ struct SwarmOptions {
       FieldSpec::InRange(0.01, 1.0, "", "share of a mutual observation's information per use (active, passive)"));
     v("time_compensation", time_compensation,
       FieldSpec::Doc("predict teammate states / shift passive observations to the update time"));
+    v("synchronize_clocks", synchronize_clocks,
+      FieldSpec::Doc("estimate teammates' clock offsets online and map their stamps to the own clock"));
+    v("clock_sync", clock_sync, FieldSpec::Doc("clock synchronisation (docs/network.md)"));
     v("max_message_age_s", max_message_age_s,
       FieldSpec::Positive("s", "teammate messages older than this are not used"));
     v("teammate_timeout_s", teammate_timeout_s,
