@@ -5,6 +5,7 @@
 #include <limits>
 #include <variant>
 
+#include "swarmlio/replay/recorded_packet_transport.h"
 
 namespace swarmlio::replay {
 
@@ -55,9 +56,32 @@ Status SwarmReplay::SetUpNetwork(const ReplayOptions& options) {
   for (size_t i = 0; i < runners_.size(); ++i) ids.push_back(static_cast<int>(i));
   SWARMLIO_RETURN_IF_ERROR(net::SimulatedNetwork::Create(options.network, ids, &network_));
   SWARMLIO_RETURN_IF_ERROR(net::PacketCodec::Create(
-      net::SwarmKey::ForSimulation(static_cast<uint64_t>(options.network.seed)), &codec_));
+      options.key ? *options.key
+                  : net::SwarmKey::ForSimulation(static_cast<uint64_t>(options.network.seed)),
+      &codec_));
+  SWARMLIO_RETURN_IF_ERROR(OpenRecordedPackets(options));
   for (int id : ids) {
-    channels_.push_back(std::make_unique<net::MessageChannel>(&codec_, network_->Endpoint(id)));
+    net::Transport* transport = recorded_[id] ? recorded_[id].get() : network_->Endpoint(id);
+    channels_.push_back(std::make_unique<net::MessageChannel>(&codec_, transport));
+  }
+  return Status::Ok();
+}
+
+Status SwarmReplay::OpenRecordedPackets(const ReplayOptions& options) {
+  recorded_.clear();
+  recorded_.resize(runners_.size());
+  for (const auto& [name, path] : options.received_packets) {
+    int id = -1;
+    for (size_t i = 0; i < runners_.size(); ++i) {
+      if (runners_[i]->input().name == name) id = static_cast<int>(i);
+    }
+    if (id < 0) {
+      return Status::InvalidArgument("received_packets: no drone named '" + name +
+                                     "' in the manifest");
+    }
+    std::unique_ptr<RecordedPacketTransport> transport;
+    SWARMLIO_RETURN_IF_ERROR(RecordedPacketTransport::Open(path, id, &transport));
+    recorded_[id] = std::move(transport);
   }
   return Status::Ok();
 }

@@ -28,6 +28,7 @@
 #include "swarm_report.h"
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/eval/error_statistics.h"
+#include "swarmlio/net/swarm_key_file.h"
 #include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
@@ -54,6 +55,13 @@ DEFINE_string(window_linear_solver, "",
 DEFINE_string(window_reassociate, "",
               "all | newest: re-associate every scan of the window at each iteration, or only "
               "the newest (default: each drone's odometry.window.reassociate_all_scans)");
+DEFINE_string(received_packets, "",
+              "offline re-run of live drones (docs/online.md): name=<name>_received.bin,... "
+              "those drones receive exactly the recorded datagrams at their recorded arrival "
+              "times instead of the simulated network (needs --key_file)");
+DEFINE_string(key_file, "",
+              "the swarm key (64 hex digits) the recorded datagrams were authenticated with; "
+              "default: the simulation key of the network seed");
 DEFINE_string(network_config, "",
               "YAML file with a `network:` section (latency, jitter, loss, reordering, "
               "duplication, seed; docs/network.md); default: the NetworkOptions defaults");
@@ -68,6 +76,27 @@ std::vector<std::string> Split(const std::string& s) {
     if (!item.empty()) out.push_back(item);
   }
   return out;
+}
+
+// --received_packets and --key_file into the replay options.
+Status ApplyReceivedPacketFlags(replay::ReplayOptions* options) {
+  for (const std::string& item : Split(FLAGS_received_packets)) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size()) {
+      return Status::InvalidArgument("--received_packets: '" + item +
+                                     "' is not name=path (e.g. uav1=out/uav1_received.bin)");
+    }
+    options->received_packets[item.substr(0, eq)] = item.substr(eq + 1);
+  }
+  if (!FLAGS_key_file.empty()) {
+    net::SwarmKey key;
+    SWARMLIO_RETURN_IF_ERROR(net::LoadSwarmKeyFile(FLAGS_key_file, &key).WithContext("--key_file"));
+    options->key = key;
+  } else if (!options->received_packets.empty()) {
+    return Status::InvalidArgument(
+        "--received_packets needs --key_file (the live swarm's key authenticates the datagrams)");
+  }
+  return Status::Ok();
 }
 
 // The back-end flags, applied to every drone's odometry options.
@@ -267,6 +296,11 @@ int Main() {
       std::fprintf(stderr, "error: %s\n", status.message().c_str());
       return 1;
     }
+  }
+  status = ApplyReceivedPacketFlags(&options);
+  if (!status.ok()) {
+    std::fprintf(stderr, "error: %s\n", status.message().c_str());
+    return 1;
   }
   options.on_progress = [&](const replay::ReplayProgress& p) {
     std::ostringstream detail;

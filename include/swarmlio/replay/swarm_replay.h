@@ -17,7 +17,9 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +51,14 @@ struct ReplayOptions {
   bool single_agent = false;
   /// The simulated network (latency, jitter, loss, reordering, duplication).
   net::NetworkOptions network;
+  /// Offline re-run of live drones (docs/online.md): drone name -> packet log
+  /// (`<name>_received.bin` of swarmlio_live). Such a drone receives exactly
+  /// the logged datagrams at their logged arrival times instead of the
+  /// simulated network; what it sends is discarded.
+  std::map<std::string, std::string> received_packets;
+  /// Key of the packet codec (the live swarm's key for received_packets);
+  /// default: SwarmKey::ForSimulation(network.seed).
+  std::optional<net::SwarmKey> key;
 };
 
 /// What one drone's channel received.
@@ -83,12 +93,14 @@ class SwarmReplay {
   SwarmManifest manifest_;
   std::vector<std::unique_ptr<DroneRunner>> runners_;
   Status SetUpNetwork(const ReplayOptions& options);
+  Status OpenRecordedPackets(const ReplayOptions& options);
   Status Broadcast(int drone, int64_t now_ns);
   std::vector<net::SwarmMessage> outbox_;
 
   std::unique_ptr<net::SimulatedNetwork> network_;
   net::PacketCodec codec_;
   std::vector<std::unique_ptr<net::MessageChannel>> channels_;
+  std::vector<std::unique_ptr<net::Transport>> recorded_;  // received_packets transports
   std::vector<DroneTraffic> traffic_;
   int64_t start_stamp_ns_ = 0;
   int64_t end_stamp_ns_ = 0;
