@@ -132,10 +132,13 @@ Status SwarmReplay::Run(const ReplayOptions& options) {
     if (!channels_.empty()) {
       // What reached this drone by the stamp of its next record.
       inbox.clear();
-      const Status polled = channels_[best]->Poll(best_true_ns, &inbox);
+      // A live recording (received_packets) is on the drone's own time line.
+      const bool recorded = recorded_[best] != nullptr;
+      const Status polled =
+          channels_[best]->Poll(recorded ? progress.stamp_ns : best_true_ns, &inbox);
       if (!polled.ok() && first_error.ok()) first_error = polled;
       for (net::ReceivedMessage& m : inbox) {
-        m.arrival_ns = runners_[best]->input().true_clock.ToDrone(m.arrival_ns);
+        if (!recorded) m.arrival_ns = runners_[best]->input().true_clock.ToDrone(m.arrival_ns);
         ++traffic_[best].received;
         if (std::holds_alternative<net::EgoStateMessage>(m.message)) ++traffic_[best].ego_states;
         runners_[best]->Deliver(m);
