@@ -122,17 +122,20 @@ fuzz_stage() {
 
 # ThreadSanitizer on the tests that run more than one thread: the simulator's
 # per-drone workers (Simulator::Run with num_threads = 2) in-process and
-# through the swarmlio_sim tool. No other library code starts threads.
-TSAN_TESTS='^(Scenario\.ParsesAndSimulatesDeterministically|Imperfections\.RealisticRunLosesAndJittersImuSamples|sim\.same_seed_gives_identical_bytes(_realistic)?)$'
+# through the swarmlio_sim tool, and the live process (swarmlio_live: input,
+# estimator and network threads per drone, three drones over UDP in one test;
+# docs/online.md) with its queue and recording tests. No other library code
+# starts threads.
+TSAN_TESTS='^(Scenario\.ParsesAndSimulatesDeterministically|Imperfections\.RealisticRunLosesAndJittersImuSamples|sim\.same_seed_gives_identical_bytes(_realistic)?|(BoundedQueue|PacketLog|RecordedPacketTransport|ImuRateOdometry|LiveSwarmTest|LiveDrone)\.[A-Za-z]+)$'
 tsan_stage() {
-  log "thread sanitizer stage: -fsanitize=thread on the threaded simulator tests"
+  log "thread sanitizer stage: -fsanitize=thread on the threaded simulator and live tests"
   # libpcl_io loads Debian's uninstrumented libOpenNI2, whose static destructors
   # unlock destroyed mutexes at exit (not our code). The options also apply to
   # the build, which runs the test binary to list its tests.
   mkdir -p "$TSAN_BUILD_DIR"
   printf 'mutex:libOpenNI2.so\n' >"$TSAN_BUILD_DIR/tsan.supp"
   local -x TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$TSAN_BUILD_DIR/tsan.supp"
-  configure_and_build_targets "$TSAN_BUILD_DIR" "swarmlio_sim_tests swarmlio_sim_tool swarmlio_bag_info" \
+  configure_and_build_targets "$TSAN_BUILD_DIR" "swarmlio_sim_tests swarmlio_sim_tool swarmlio_bag_info swarmlio_live_tests" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSWARMLIO_BUILD_BENCHMARKS=OFF \
     -DCMAKE_CXX_FLAGS=-fsanitize=thread -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread \
     -DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread

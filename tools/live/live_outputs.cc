@@ -1,0 +1,95 @@
+#include "live_outputs.h"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+namespace swarmlio::tools {
+namespace {
+
+Status OpenFile(const std::string& path, const char* header, std::FILE** file) {
+  *file = std::fopen(path.c_str(), "w");
+  if (*file == nullptr) return Status::IoError(path + ": " + std::strerror(errno));
+  if (std::fputs(header, *file) < 0) return Status::IoError(path + ": write failed");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status LiveOutputs::Open(const std::string& dir, const std::string& name, bool imu_odometry,
+                         std::unique_ptr<LiveOutputs>* outputs) {
+  std::unique_ptr<LiveOutputs> o(new LiveOutputs());
+  const std::filesystem::path base(dir);
+  o->tum_path_ = (base / (name + "_tum.txt")).string();
+  o->timing_path_ = (base / (name + "_timing.csv")).string();
+  SWARMLIO_RETURN_IF_ERROR(
+      OpenFile(o->tum_path_, "# timestamp tx ty tz qx qy qz qw\n", &o->tum_));
+  SWARMLIO_RETURN_IF_ERROR(OpenFile(
+      o->timing_path_,
+      "stamp_s,dropped,updated,raw_points,points,correspondences,iterations,degenerate,"
+      "teammates,active_observations,passive_observations,total_ms,latency_ms\n",
+      &o->timing_));
+  if (imu_odometry) {
+    o->imu_path_ = (base / (name + "_imu_odom.csv")).string();
+    SWARMLIO_RETURN_IF_ERROR(OpenFile(
+        o->imu_path_, "stamp_s,x_m,y_m,z_m,qx,qy,qz,qw,vx_m_s,vy_m_s,vz_m_s,wx_rad_s,wy_rad_s,wz_rad_s\n",
+        &o->imu_));
+  }
+  *outputs = std::move(o);
+  return Status::Ok();
+}
+
+LiveOutputs::~LiveOutputs() { (void)Close(); }
+
+void LiveOutputs::Check(bool ok, const std::string& path) {
+  if (!ok && error_.empty()) error_ = path + ": write failed: " + std::strerror(errno);
+}
+
+void LiveOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& latency) {
+  const EgoState& x = o.ego.state;
+  const double t_s = StampSeconds(o.ego.stamp_ns);
+  Check(std::fprintf(tum_, "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", t_s,
+                     x.p_b_in_G.x(), x.p_b_in_G.y(), x.p_b_in_G.z(), x.q_G_b.x(), x.q_G_b.y(),
+                     x.q_G_b.z(), x.q_G_b.w()) > 0,
+        tum_path_);
+  const double latency_ms = 1e-6 * static_cast<double>(latency.latency_ns());
+  latencies_ms_.push_back(static_cast<float>(latency_ms));
+  Check(std::fprintf(timing_, "%.9f,,%d,%d,%d,%d,%d,%d,%zu,%d,%d,%.3f,%.3f\n", t_s,
+                     o.ego.updated ? 1 : 0, o.ego.num_raw_points, o.ego.num_points,
+                     o.ego.num_correspondences, o.ego.iterations, o.ego.degenerate ? 1 : 0,
+                     o.teammates.size(), o.active_observations, o.passive_observations,
+                     1e3 * o.ego.timings.total_s, latency_ms) > 0,
+        timing_path_);
+}
+
+void LiveOutputs::OnScanDropped(int64_t scan_stamp_ns, live::ScanDropReason reason) {
+  Check(std::fprintf(timing_, "%.9f,%s,,,,,,,,,,,\n", StampSeconds(scan_stamp_ns),
+                     reason == live::ScanDropReason::kQueueFull ? "queue" : "backlog") > 0,
+        timing_path_);
+}
+
+void LiveOutputs::OnImuPose(const live::ImuRatePose& p) {
+  if (imu_poses_ == 0) first_imu_pose_ns_ = p.stamp_ns;
+  last_imu_pose_ns_ = p.stamp_ns;
+  ++imu_poses_;
+  if (imu_ == nullptr) return;
+  const Eigen::Vector3d& w = p.angular_velocity_in_b_rad_s;
+  Check(std::fprintf(imu_, "%.9f,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f\n",
+                     StampSeconds(p.stamp_ns), p.p_b_in_G.x(), p.p_b_in_G.y(), p.p_b_in_G.z(),
+                     p.q_G_b.x(), p.q_G_b.y(), p.q_G_b.z(), p.q_G_b.w(), p.v_b_in_G.x(),
+                     p.v_b_in_G.y(), p.v_b_in_G.z(), w.x(), w.y(), w.z()) > 0,
+        imu_path_);
+}
+
+Status LiveOutputs::Close() {
+  for (auto [file, path] : {std::pair{&tum_, &tum_path_}, std::pair{&timing_, &timing_path_},
+                            std::pair{&imu_, &imu_path_}}) {
+    if (*file == nullptr) continue;
+    Check(std::fclose(*file) == 0, *path);
+    *file = nullptr;
+  }
+  return error_.empty() ? Status::Ok() : Status::IoError(error_);
+}
+
+}  // namespace swarmlio::tools

@@ -1,0 +1,53 @@
+// The files swarmlio_live writes while it runs (a live::LiveSink, streamed:
+// nothing per scan is kept but one float of latency):
+//   <name>_tum.txt       estimated trajectory, TUM, one pose per scan end
+//   <name>_timing.csv    per scan: counts, stage total, latency scan end -> odometry out;
+//                        a dropped scan is a row with `dropped` = queue | backlog
+//   <name>_imu_odom.csv  the IMU-rate propagated state (one row per IMU sample)
+#pragma once
+
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/live/live_sink.h"
+
+namespace swarmlio::tools {
+
+class LiveOutputs : public live::LiveSink {
+ public:
+  /// Creates the files in `dir`; `imu_odometry` false: no IMU-rate file.
+  static Status Open(const std::string& dir, const std::string& name, bool imu_odometry,
+                     std::unique_ptr<LiveOutputs>* outputs);
+  ~LiveOutputs() override;
+
+  void OnScan(const swarm::DroneOutput& output, const live::ScanLatency& latency) override;
+  void OnScanDropped(int64_t scan_stamp_ns, live::ScanDropReason reason) override;
+  void OnImuPose(const live::ImuRatePose& pose) override;
+
+  /// Closes the files; the first write error, naming the file.
+  Status Close();
+
+  const std::vector<float>& latencies_ms() const { return latencies_ms_; }
+  int64_t imu_poses() const { return imu_poses_; }
+  int64_t first_imu_pose_ns() const { return first_imu_pose_ns_; }
+  int64_t last_imu_pose_ns() const { return last_imu_pose_ns_; }
+
+ private:
+  LiveOutputs() = default;
+  void Check(bool ok, const std::string& path);
+
+  std::string tum_path_, timing_path_, imu_path_;
+  std::FILE* tum_ = nullptr;
+  std::FILE* timing_ = nullptr;
+  std::FILE* imu_ = nullptr;
+  std::vector<float> latencies_ms_;
+  int64_t imu_poses_ = 0;
+  int64_t first_imu_pose_ns_ = 0;
+  int64_t last_imu_pose_ns_ = 0;
+  std::string error_;
+};
+
+}  // namespace swarmlio::tools
