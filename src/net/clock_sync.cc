@@ -277,6 +277,7 @@ ClockSync::ClockSync(int self_id, const ClockSyncOptions& options)
     : self_id_(self_id),
       options_(options),
       period_ns_(std::max<int64_t>(1, SecondsToNs(options.request_period_s))),
+      settled_period_ns_(std::max<int64_t>(1, SecondsToNs(options.settled_request_period_s))),
       burst_period_ns_(std::max<int64_t>(1, SecondsToNs(options.burst_period_s))),
       timeout_ns_(SecondsToNs(options.response_timeout_s)) {}
 
@@ -315,7 +316,15 @@ void ClockSync::DueRequests(int64_t now_ns, std::vector<TimeSyncMessage>* reques
   for (auto& [id, teammate] : teammates_) {
     ExpireRequests(now_ns, &teammate);
     if (teammate.next_request_ns > now_ns) continue;
-    const int64_t spacing = teammate.burst_remaining > 0 ? burst_period_ns_ : period_ns_;
+    // Burst first; then the regular period, or the slow one while the offset
+    // extrapolated to the end of the slow period is known well enough (its
+    // std grows with the drift's uncertainty, so a teammate whose requests go
+    // unanswered or whose drift is not known yet is polled fast).
+    int64_t spacing = teammate.burst_remaining > 0 ? burst_period_ns_ : period_ns_;
+    if (teammate.burst_remaining == 0 && options_.settled_std_s > 0.0) {
+      const ClockOffsetEstimate e = teammate.estimator.Estimate(now_ns + settled_period_ns_);
+      if (e.converged && e.std_ns <= options_.settled_std_s * 1e9) spacing = settled_period_ns_;
+    }
     teammate.burst_remaining = std::max(0, teammate.burst_remaining - 1);
     // Regular spacing; after a pause (no calls for a while) no catch-up burst.
     teammate.next_request_ns += spacing;

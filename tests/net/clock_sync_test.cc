@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -193,6 +195,47 @@ TEST(ClockSync, SchedulesABurstThenOneRequestPerPeriod) {
   EXPECT_EQ(times,
             (std::vector<int64_t>{0, 250, 500, 750, 1000, 1250, 1500, 1750, 2000, 3000, 4000}));
   EXPECT_EQ(sync->Stats(1).requests_sent, 11u);
+}
+
+// Once the offset is known within settled_std_s, one request per
+// settled_request_period_s; with the requests unanswered it stays at the
+// regular period.
+TEST(ClockSync, SlowsDownOnceTheOffsetIsSettled) {
+  for (const bool answered : {true, false}) {
+    std::unique_ptr<ClockSync> sync;
+    ASSERT_TRUE(ClockSync::Create(0, ClockSyncOptions(), &sync).ok());
+    const int64_t t0 = 100 * kS;
+    sync->AddTeammate(1, t0);
+    std::vector<int64_t> times;
+    for (int64_t t = t0; t <= t0 + 120 * kS; t += 50 * kMs) {
+      std::vector<TimeSyncMessage> requests;
+      sync->DueRequests(t, &requests);
+      for (const TimeSyncMessage& r : requests) {
+        times.push_back(t - t0);
+        if (!answered) continue;
+        TimeSyncMessage response = r;  // 1 ms each way, 0.1 ms turnaround, offset 0
+        response.sender_id = 1;
+        response.target_id = 0;
+        response.is_response = true;
+        response.t2_ns = r.t1_ns + kMs;
+        response.t3_ns = response.t2_ns + kMs / 10;
+        TimeSyncMessage unused;
+        sync->HandleMessage(response, response.t3_ns + kMs, response.t3_ns + kMs, &unused);
+      }
+    }
+    ASSERT_GE(times.size(), 3u);
+    const int64_t last_gap = times.back() - times[times.size() - 2];
+    if (answered) {
+      // 1 Hz until the drift is known well enough for 10 s, then every 10 s.
+      EXPECT_EQ(last_gap, 10 * kS);
+      EXPECT_LT(times.size(), 8u + 40u);
+      std::printf("[ figures  ] settled after %.0f s, %zu requests in 120 s\n",
+                  1e-9 * static_cast<double>(times[times.size() - 2]), times.size());
+    } else {
+      EXPECT_EQ(last_gap, 1 * kS);
+      EXPECT_EQ(times.size(), 8u + 119u);  // the burst (2 s), then every second
+    }
+  }
 }
 
 TEST(ClockSync, MatchesResponsesByT1AndCountsTheRest) {

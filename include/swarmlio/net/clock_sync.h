@@ -51,6 +51,9 @@ namespace swarmlio::net {
 /// YAML section `clock_sync`.
 struct ClockSyncOptions {
   double request_period_s = 1.0;     // one request per teammate per period [s]
+  double settled_request_period_s = 10.0;  // ... once the offset std is below settled_std_s [s]
+  double settled_std_s = 0.5e-3;           // (at the end of that period; NTP's poll interval
+                                           // growth; 0 = never settle) [s]
   int burst_requests = 8;            // the first requests to a teammate (and after its
   double burst_period_s = 0.25;      // clock stepped) come this fast [s], as NTP's iburst
   double response_timeout_s = 1.0;   // a response later than this is dropped [s]
@@ -68,6 +71,10 @@ struct ClockSyncOptions {
     using config::FieldSpec;
     v("request_period_s", request_period_s,
       FieldSpec::Positive("s", "interval between requests to one teammate").WithMax(3600.0));
+    v("settled_request_period_s", settled_request_period_s,
+      FieldSpec::Positive("s", "interval between requests once the offset is settled").WithMax(3600.0));
+    v("settled_std_s", settled_std_s,
+      FieldSpec::InRange(0.0, 1.0, "s", "offset std below which requests slow down (0 = never)"));
     v("burst_requests", burst_requests,
       FieldSpec::InRange(0, 64, "", "requests at burst_period_s when a teammate appears"));
     v("burst_period_s", burst_period_s,
@@ -234,6 +241,7 @@ class ClockSync {
   int self_id_;
   ClockSyncOptions options_;
   int64_t period_ns_;
+  int64_t settled_period_ns_;
   int64_t burst_period_ns_;
   int64_t timeout_ns_;
   std::map<int, Teammate> teammates_;  // ordered: deterministic request order
