@@ -126,7 +126,7 @@ fuzz_stage() {
 # estimator and network threads per drone, three drones over UDP in one test;
 # docs/online.md) with its queue and recording tests. No other library code
 # starts threads.
-TSAN_TESTS='^(Scenario\.ParsesAndSimulatesDeterministically|Imperfections\.RealisticRunLosesAndJittersImuSamples|sim\.same_seed_gives_identical_bytes(_realistic)?|(BoundedQueue|PacketLog|RecordedPacketTransport|ImuRateOdometry|LiveSwarmTest|LiveDrone)\.[A-Za-z]+)$'
+TSAN_TESTS='^(Scenario\.ParsesAndSimulatesDeterministically|Imperfections\.RealisticRunLosesAndJittersImuSamples|sim\.same_seed_gives_identical_bytes(_realistic)?|(BoundedQueue|PacketLog|RecordedPacketTransport|ImuRateOdometry|LiveSwarmTest|LiveDropTest|LiveDrone)\.[A-Za-z]+)$'
 tsan_stage() {
   log "thread sanitizer stage: -fsanitize=thread on the threaded simulator and live tests"
   # libpcl_io loads Debian's uninstrumented libOpenNI2, whose static destructors
