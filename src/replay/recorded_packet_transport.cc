@@ -8,7 +8,12 @@ Status RecordedPacketTransport::Open(const std::string& path, int self_id,
                                      std::unique_ptr<RecordedPacketTransport>* transport) {
   std::unique_ptr<RecordedPacketTransport> t(new RecordedPacketTransport());
   t->self_id_ = self_id;
-  SWARMLIO_RETURN_IF_ERROR(net::ReadPacketLog(path, &t->header_, &t->datagrams_));
+  const Status read = net::ReadPacketLog(path, &t->header_, &t->datagrams_);
+  if (read.code() == Status::Code::kDataLoss && !t->datagrams_.empty()) {
+    t->damage_ = read;  // keep the records before the damage
+  } else if (!read.ok()) {
+    return read;
+  }
   if (t->header_.self_id != self_id) {
     return Status::InvalidArgument(path + ": recorded by drone id " +
                                    std::to_string(t->header_.self_id) + ", replayed as drone id " +

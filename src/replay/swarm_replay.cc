@@ -70,6 +70,7 @@ Status SwarmReplay::SetUpNetwork(const ReplayOptions& options) {
 Status SwarmReplay::OpenRecordedPackets(const ReplayOptions& options) {
   recorded_.clear();
   recorded_.resize(runners_.size());
+  recording_damage_ = Status::Ok();
   for (const auto& [name, path] : options.received_packets) {
     int id = -1;
     for (size_t i = 0; i < runners_.size(); ++i) {
@@ -81,6 +82,8 @@ Status SwarmReplay::OpenRecordedPackets(const ReplayOptions& options) {
     }
     std::unique_ptr<RecordedPacketTransport> transport;
     SWARMLIO_RETURN_IF_ERROR(RecordedPacketTransport::Open(path, id, &transport));
+    // A damaged log re-runs with its complete records; Run() reports it.
+    if (recording_damage_.ok()) recording_damage_ = transport->damage();
     recorded_[id] = std::move(transport);
   }
   return Status::Ok();
@@ -167,6 +170,7 @@ Status SwarmReplay::Run(const ReplayOptions& options) {
     progress.stamp_ns = progress.end_stamp_ns;
     options.on_progress(progress);
   }
+  if (first_error.ok()) first_error = recording_damage_;
   return first_error;
 }
 

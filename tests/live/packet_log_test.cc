@@ -185,5 +185,21 @@ TEST(RecordedPacketTransport, PlaysBackByArrivalTime) {
   EXPECT_NE(other.message().find("drone id 2"), std::string::npos) << other.message();
 }
 
+TEST(RecordedPacketTransport, DamagedLogPlaysItsCompleteRecords) {
+  swarmlio::testing::TempDir dir;
+  const std::vector<Datagram> data = SomeDatagrams();
+  const std::string path = Write(dir, data);
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 3);  // a killed writer
+  std::unique_ptr<replay::RecordedPacketTransport> t;
+  const Status s = replay::RecordedPacketTransport::Open(path, 2, &t);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(t->damage().code(), Status::Code::kDataLoss);
+  EXPECT_NE(t->damage().message().find("record 4"), std::string::npos) << t->damage().message();
+  std::vector<Datagram> got;
+  ASSERT_TRUE(t->Poll(2'000'000'000, &got).ok());
+  ASSERT_EQ(got.size(), 4u);
+  ExpectEqual(got, data, 4);
+}
+
 }  // namespace
 }  // namespace swarmlio::net

@@ -20,8 +20,11 @@ namespace swarmlio::replay {
 
 class RecordedPacketTransport : public net::Transport {
  public:
-  /// Reads the whole log. A damaged log is an error (naming the file), as is
-  /// a log recorded by another drone id than `self_id`.
+  /// Reads the whole log. Errors (naming the file): cannot open, not a
+  /// packet log, unsupported version, recorded by another drone id than
+  /// `self_id`. A truncated or corrupt log (e.g. the live process was
+  /// killed) opens with the complete records before the damage, and
+  /// damage() says what was lost.
   static Status Open(const std::string& path, int self_id,
                      std::unique_ptr<RecordedPacketTransport>* transport);
 
@@ -34,6 +37,8 @@ class RecordedPacketTransport : public net::Transport {
   int64_t delivered() const { return static_cast<int64_t>(next_); }
   int64_t sent_discarded() const { return sent_discarded_; }
   const net::PacketLogHeader& header() const { return header_; }
+  /// Ok, or the DataLoss the log was read with (its records up to the damage are kept).
+  const Status& damage() const { return damage_; }
 
  private:
   RecordedPacketTransport() = default;
@@ -43,6 +48,7 @@ class RecordedPacketTransport : public net::Transport {
   std::vector<net::Datagram> datagrams_;
   size_t next_ = 0;
   int64_t sent_discarded_ = 0;
+  Status damage_;
 };
 
 }  // namespace swarmlio::replay

@@ -54,7 +54,8 @@ struct ReplayOptions {
   /// Offline re-run of live drones (docs/online.md): drone name -> packet log
   /// (`<name>_received.bin` of swarmlio_live). Such a drone receives exactly
   /// the logged datagrams at their logged arrival times instead of the
-  /// simulated network; what it sends is discarded.
+  /// simulated network; what it sends is discarded. A truncated or corrupt
+  /// log is re-run up to the damage and Run() returns its DataLoss.
   std::map<std::string, std::string> received_packets;
   /// Key of the packet codec (the live swarm's key for received_packets);
   /// default: SwarmKey::ForSimulation(network.seed).
@@ -101,6 +102,7 @@ class SwarmReplay {
   net::PacketCodec codec_;
   std::vector<std::unique_ptr<net::MessageChannel>> channels_;
   std::vector<std::unique_ptr<net::Transport>> recorded_;  // received_packets transports
+  Status recording_damage_;  // the first damaged received_packets log (re-run up to the damage)
   std::vector<DroneTraffic> traffic_;
   int64_t start_stamp_ns_ = 0;
   int64_t end_stamp_ns_ = 0;
