@@ -324,6 +324,34 @@ int Main() {
                   static_cast<long long>(t.received),
                   static_cast<unsigned long long>(t.channel.rejected),
                   static_cast<unsigned long long>(t.channel.duplicates));
+      // Membership and fusion counters of the component (swarm::DroneEstimatorCounters).
+      const swarm::DroneEstimatorCounters& c = run->drone(i).estimator().counters();
+      std::printf("  messages ignored %lld, waiting for a clock offset %lld; teammates identified "
+                  "%lld, removed %lld, restarted %lld; observations fused %lld active / %lld "
+                  "passive / %lld gravity, rejected %lld\n",
+                  static_cast<long long>(c.messages_ignored),
+                  static_cast<long long>(c.messages_unsynchronized),
+                  static_cast<long long>(c.identifications),
+                  static_cast<long long>(c.teammates_removed),
+                  static_cast<long long>(c.teammate_restarts),
+                  static_cast<long long>(c.active_fused), static_cast<long long>(c.passive_fused),
+                  static_cast<long long>(c.gravity_fused),
+                  static_cast<long long>(c.observations_rejected));
+      if (const net::ClockSync* sync = run->drone(i).estimator().clock_sync()) {
+        const auto& scans = run->drone(i).scans();
+        const int64_t now_ns = scans.empty() ? 0 : scans.back().stamp_ns;
+        for (int j = 0; j < run->num_drones(); ++j) {
+          const net::ClockOffsetEstimate e = sync->Estimate(j, now_ns);
+          if (j == i || !e.valid) continue;
+          const net::ClockSyncStats st = sync->Stats(j);
+          std::printf("  clock of %s: offset %+.3f ms (std %.3f ms, drift %+.1f ppm), %d exchanges, "
+                      "%llu requests, %llu timed out\n",
+                      run->drone(j).input().name.c_str(), 1e-6 * static_cast<double>(e.offset_ns),
+                      1e-6 * e.std_ns, e.drift_ppm, e.num_samples,
+                      static_cast<unsigned long long>(st.requests_sent),
+                      static_cast<unsigned long long>(st.requests_timed_out));
+        }
+      }
     }
   }
   ReportOptions report;

@@ -86,7 +86,7 @@ struct DroneOutput {
 
 struct DroneEstimatorCounters {
   int64_t messages_received = 0;
-  int64_t messages_ignored = 0;   // own, unknown type, non-finite, or stale
+  int64_t messages_ignored = 0;   // own, unknown type, non-finite, stale, or a TimeSync for another drone
   int64_t teammate_restarts = 0;  // session_start changed
   int64_t messages_unsynchronized = 0;  // states of a teammate whose clock offset is not known yet
   int64_t identifications = 0;
