@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "swarmlio/live/live_drone.h"
+#include "swarmlio/live/steady_clock.h"
 #include "swarmlio/net/simulated_network.h"
 #include "swarmlio/net/udp_transport.h"
 #include "swarmlio/replay/swarm_replay.h"
@@ -56,18 +57,6 @@ constexpr double kRate = 4.0;
 constexpr bool kSanitized = false;
 #endif
 constexpr double kDropTestDurationS = 4.0;  // one drone on the racing clock
-
-class SteadyTestClock : public Clock {
- public:
-  int64_t NowNs() const override {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-  }
-  void SleepForNs(int64_t duration_ns) const override {
-    std::this_thread::sleep_for(std::chrono::nanoseconds(duration_ns));
-  }
-};
 
 /// Virtual time that advances 50 ms at every reading (and by every sleep):
 /// the input thread alone moves it 10x faster than the 200 Hz records it
@@ -165,7 +154,7 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
     peers[i].port = FreeUdpPort();
     ASSERT_GT(peers[i].port, 0);
   }
-  SteadyTestClock clock;
+  SteadyClock clock;
   std::vector<std::unique_ptr<net::UdpTransport>> udp(3);
   std::vector<CollectingSink> sinks(3);
   std::vector<std::unique_ptr<LiveDrone>> drones(3);
@@ -315,7 +304,7 @@ TEST_F(LiveDropTest, FallingBehindDropsWholeScansNeverImu) {
 TEST(LiveDrone, CreateRejectsBadSetupAndOptions) {
   std::unique_ptr<net::SimulatedNetwork> network;
   ASSERT_TRUE(net::SimulatedNetwork::Create(net::NetworkOptions(), {0, 1}, &network).ok());
-  SteadyTestClock clock;
+  SteadyClock clock;
   LiveSetup setup;
   setup.drone.name = "uav9";
   setup.drone.bag_path = "/nonexistent/uav9.bag";

@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "live_outputs.h"
-#include "steady_clock.h"
 #include "swarmlio/eval/error_statistics.h"
 #include "swarmlio/live/live_drone.h"
+#include "swarmlio/live/steady_clock.h"
 #include "swarmlio/net/swarm_key_file.h"
 #include "swarmlio/net/udp_transport.h"
 #include "swarmlio/replay/manifest.h"
@@ -228,7 +228,7 @@ int Main() {
   std::unique_ptr<LiveOutputs> outputs;
   status = LiveOutputs::Open(FLAGS_output_dir, drone.name, FLAGS_imu_odom, &outputs);
   if (!status.ok()) return Fail(status);
-  SteadyClock clock;
+  live::SteadyClock clock;
   setup.drone = drone;
   setup.drone_id = drone_id;
   setup.transport = udp.get();

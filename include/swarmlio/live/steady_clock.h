@@ -1,5 +1,6 @@
-// live::Clock on std::chrono::steady_clock: what swarmlio_live runs on (the
-// library itself never reads a clock).
+// live::Clock on std::chrono::steady_clock: what swarmlio_live and the live
+// tests run on. LiveDrone never reads a clock itself; drivers inject this one
+// (or an accelerated / fake one).
 #pragma once
 
 #include <chrono>
@@ -7,9 +8,9 @@
 
 #include "swarmlio/live/clock.h"
 
-namespace swarmlio::tools {
+namespace swarmlio::live {
 
-class SteadyClock : public live::Clock {
+class SteadyClock : public Clock {
  public:
   int64_t NowNs() const override {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -21,4 +22,4 @@ class SteadyClock : public live::Clock {
   }
 };
 
-}  // namespace swarmlio::tools
+}  // namespace swarmlio::live
