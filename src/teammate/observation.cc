@@ -36,8 +36,7 @@ ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptio
   }
   const double range = centre.p_in_b.norm();
   if (range <= 0.0) return centre;
-  const bool band_known = options.tape_half_length_m > 0.0 && options.tape_half_width_m > 0.0;
-  if (tape_only && band_known && R_bi_bj != nullptr) {
+  if (tape_only && options.UsesTapeBand() && R_bi_bj != nullptr) {
     const Eigen::Vector3d u_in_bj = R_bi_bj->transpose() * (-centre.p_in_b / range);
     centre.p_in_b -= *R_bi_bj * TapeCentroidInBody(u_in_bj, options.tape_half_length_m,
                                                   options.tape_half_width_m);

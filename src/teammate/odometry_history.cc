@@ -41,15 +41,7 @@ bool OdometryHistory::StateAt(double stamp_s, double max_gap_s, double max_extra
     }
   }
   // Nearest message, extrapolated with its velocity.
-  const TeammateOdometry* nearest = nullptr;
-  if (after != messages_.end()) nearest = &*after;
-  if (after != messages_.begin()) {
-    const TeammateOdometry& before = *(after - 1);
-    if (nearest == nullptr ||
-        std::abs(before.stamp_s - stamp_s) < std::abs(nearest->stamp_s - stamp_s)) {
-      nearest = &before;
-    }
-  }
+  const TeammateOdometry* nearest = Nearest(stamp_s);
   const double dt = stamp_s - nearest->stamp_s;
   if (std::abs(dt) > max_extrapolation_s) return false;
   *p_bj_in_Gj = nearest->p_bj_in_Gj + nearest->v_bj_in_Gj * dt;
@@ -57,9 +49,8 @@ bool OdometryHistory::StateAt(double stamp_s, double max_gap_s, double max_extra
   return true;
 }
 
-bool OdometryHistory::AttitudeAt(double stamp_s, double max_age_s,
-                                 Eigen::Quaterniond* q_Gj_bj) const {
-  if (messages_.empty()) return false;
+const TeammateOdometry* OdometryHistory::Nearest(double stamp_s) const {
+  if (messages_.empty()) return nullptr;
   auto after = std::lower_bound(
       messages_.begin(), messages_.end(), stamp_s,
       [](const TeammateOdometry& m, double s) { return m.stamp_s < s; });
@@ -71,7 +62,13 @@ bool OdometryHistory::AttitudeAt(double stamp_s, double max_age_s,
       nearest = &before;
     }
   }
-  if (std::abs(nearest->stamp_s - stamp_s) > max_age_s) return false;
+  return nearest;
+}
+
+bool OdometryHistory::AttitudeAt(double stamp_s, double max_age_s,
+                                 Eigen::Quaterniond* q_Gj_bj) const {
+  const TeammateOdometry* nearest = Nearest(stamp_s);
+  if (nearest == nullptr || std::abs(nearest->stamp_s - stamp_s) > max_age_s) return false;
   *q_Gj_bj = nearest->q_Gj_bj;
   return true;
 }

@@ -103,10 +103,12 @@ void TeammateDetector::TrackTeammates(double stamp_s, const Eigen::Isometry3d& T
       continue;
     }
     // The teammate's attitude relative to mine, from its broadcast through
-    // T_Gi_Gj, places the body origin behind the tape (observation.h).
+    // T_Gi_Gj, places the body origin behind the tape (observation.h, only
+    // with the band model configured).
     Eigen::Quaterniond q_Gj_bj;
     Eigen::Matrix3d R_bi_bj;
     const bool attitude_known =
+        options_.observation.UsesTapeBand() &&
         history.AttitudeAt(stamp_s, options_.teammate.max_odometry_age_s, &q_Gj_bj);
     if (attitude_known) {
       R_bi_bj = T_Gi_bi.linear().transpose() * tracker.R_Gi_Gj() * q_Gj_bj.toRotationMatrix();

@@ -80,6 +80,8 @@ struct ObservationOptions {
     v("min_range_m", min_range_m, FieldSpec::AtLeast(0.0, "m", "closer clusters are not reported"));
   }
   std::string Validate() const { return config::ValidateFields(*this); }
+  /// The band model of the file comment is configured.
+  bool UsesTapeBand() const { return tape_half_length_m > 0.0 && tape_half_width_m > 0.0; }
 };
 
 /// ^{b_i}p_{b_j} with its covariance, at the scan stamp.

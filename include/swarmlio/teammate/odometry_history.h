@@ -34,6 +34,9 @@ class OdometryHistory {
   bool AttitudeAt(double stamp_s, double max_age_s, Eigen::Quaterniond* q_Gj_bj) const;
 
  private:
+  // The message nearest to `stamp_s` (ties: the later one); null when empty.
+  const TeammateOdometry* Nearest(double stamp_s) const;
+
   std::deque<TeammateOdometry> messages_;  // sorted by stamp
 };
 
