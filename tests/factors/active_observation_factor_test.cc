@@ -14,26 +14,14 @@
 #include "factors/global_extrinsic_manifold.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
+#include "test_utils/random_sampler.h"
 
 namespace swarmlio {
 namespace {
 
-class Sampler {
+class Sampler : public swarmlio::testing::RandomSampler {
  public:
-  explicit Sampler(unsigned seed) : rng_(seed) {}
-  double Normal() { return n_(rng_); }
-  Eigen::Vector3d Gaussian3(double scale) {
-    return scale * Eigen::Vector3d(Normal(), Normal(), Normal());
-  }
-  Eigen::Vector3d Axis() { return Gaussian3(1.0).normalized(); }
-  // Rotation by `angle` about a random axis (uniformly random when < 0).
-  Eigen::Quaterniond Rotation(double angle) {
-    if (angle < 0) {
-      return Eigen::Quaterniond(
-          Eigen::Vector4d(Normal(), Normal(), Normal(), Normal()).normalized());
-    }
-    return so3::ExpQuaternion(Axis() * angle);
-  }
+  using RandomSampler::RandomSampler;
   EgoState Ego(double angle) {
     EgoState ego;
     ego.q_G_b = Rotation(angle);
@@ -55,10 +43,6 @@ class Sampler {
     for (int i = 0; i < 9; ++i) A.data()[i] = scale * Normal();
     return A * A.transpose() + floor * Eigen::Matrix3d::Identity();
   }
-
- private:
-  std::mt19937 rng_;
-  std::normal_distribution<double> n_;
 };
 
 // The definition, written independently of the factor.

@@ -25,6 +25,7 @@
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
+#include "test_utils/random_sampler.h"
 
 namespace swarmlio::imu_preintegration_test {
 
@@ -35,27 +36,7 @@ using Vector18 = Eigen::Matrix<double, 18, 1>;
 
 inline constexpr int64_t kImuPeriodNs = 5'000'000;  // 200 Hz
 
-class Sampler {
- public:
-  explicit Sampler(unsigned seed) : rng_(seed) {}
-  double Normal() { return n_(rng_); }
-  Eigen::Vector3d Gaussian3(double scale) {
-    return scale * Eigen::Vector3d(Normal(), Normal(), Normal());
-  }
-  Eigen::Vector3d Axis() { return Gaussian3(1.0).normalized(); }
-  // Rotation by `angle` about a random axis (uniformly random when < 0).
-  Eigen::Quaterniond Rotation(double angle) {
-    if (angle < 0) {
-      return Eigen::Quaterniond(
-          Eigen::Vector4d(Normal(), Normal(), Normal(), Normal()).normalized());
-    }
-    return so3::ExpQuaternion(Axis() * angle);
-  }
-
- private:
-  std::mt19937 rng_;
-  std::normal_distribution<double> n_;
-};
+using Sampler = swarmlio::testing::RandomSampler;
 
 // R(t) = R0 Exp(w t), v(t) = v0 + a t, p(t) = p0 + v0 t + a t^2 / 2; the IMU
 // measures w + b_g and R(t)^T (a - g) + b_a, reported divided by

@@ -12,25 +12,17 @@
 #include "factors/ego_state_manifold.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
+#include "test_utils/random_sampler.h"
 
 namespace swarmlio {
 namespace {
 
-class Sampler {
+class Sampler : public swarmlio::testing::RandomSampler {
  public:
-  explicit Sampler(unsigned seed) : rng_(seed) {}
-  double Normal() { return n_(rng_); }
-  double Uniform(double lo, double hi) { return std::uniform_real_distribution<>(lo, hi)(rng_); }
-  Eigen::Vector3d Gaussian3(double scale) {
-    return scale * Eigen::Vector3d(Normal(), Normal(), Normal());
-  }
-  Eigen::Vector3d Axis() { return Gaussian3(1.0).normalized(); }
+  using RandomSampler::RandomSampler;
   EgoState Ego(double angle) {
     EgoState ego;
-    ego.q_G_b = angle < 0
-                    ? Eigen::Quaterniond(
-                          Eigen::Vector4d(Normal(), Normal(), Normal(), Normal()).normalized())
-                    : so3::ExpQuaternion(Axis() * angle);
+    ego.q_G_b = Rotation(angle);
     ego.p_b_in_G = Gaussian3(5.0);
     ego.v_b_in_G = Gaussian3(1.0);
     return ego;
@@ -48,10 +40,6 @@ class Sampler {
     }
     return out;
   }
-
- private:
-  std::mt19937 rng_;
-  std::normal_distribution<double> n_;
 };
 
 TEST(PointToPlaneFactor, ResidualIsEquationFour) {
