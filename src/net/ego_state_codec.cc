@@ -22,6 +22,26 @@ Status DecodeObservation(WireReader* r, TeammateObservation* o) {
   return ReadCovariance<3>("cov_p_bk_in_bj", r, &o->cov_p_bk_in_bj);
 }
 
+/// The float32 position the receiver decodes: past observations travel
+/// relative to it.
+Eigen::Vector3d AsSentF32(const Eigen::Vector3d& v) { return v.cast<float>().cast<double>(); }
+
+Status DecodePastObservation(const Eigen::Vector3d& p_bj_in_Gj, WireReader* r,
+                             PastObservation* o) {
+  uint8_t id = 0;
+  SWARMLIO_RETURN_IF_ERROR(r->U8("observed_id", &id));
+  o->observed_id = id;
+  uint16_t age = 0;
+  SWARMLIO_RETURN_IF_ERROR(r->U16("age", &age));
+  if (age == 0) return r->Invalid("age", -1, "is 0 (a past observation is older than the state)");
+  o->age_ns = int64_t{age} * kPastObservationAgeStepNs;
+  Eigen::Vector3d relative;
+  SWARMLIO_RETURN_IF_ERROR(
+      ReadScaledVectorI16("p_bk_in_Gj - p_bj_in_Gj", kObservationPositionStepM, r, &relative));
+  o->p_bk_in_Gj = p_bj_in_Gj + relative;
+  return ReadCovariance<3>("cov_p_bk_in_Gj", r, &o->cov_p_bk_in_Gj);
+}
+
 }  // namespace
 
 void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
@@ -41,6 +61,15 @@ void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
     w->U8(static_cast<uint8_t>(o.observed_id));
     WriteScaledVectorI16(o.p_bk_in_bj, kObservationPositionStepM, w);
     WriteCovariance<3>(o.cov_p_bk_in_bj, w);
+  }
+  if (m.past_observations.empty()) return;  // the version 3 layout
+  w->U8(static_cast<uint8_t>(m.past_observations.size()));
+  const Eigen::Vector3d p_bj_sent = AsSentF32(m.p_bj_in_Gj);
+  for (const PastObservation& o : m.past_observations) {
+    w->U8(static_cast<uint8_t>(o.observed_id));
+    w->U16(static_cast<uint16_t>(PastObservationAgeCode(o.age_ns)));
+    WriteScaledVectorI16(o.p_bk_in_Gj - p_bj_sent, kObservationPositionStepM, w);
+    WriteCovariance<3>(o.cov_p_bk_in_Gj, w);
   }
 }
 
@@ -62,8 +91,9 @@ Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* out) {
                             std::to_string(EgoStateMessage::kMaxObservations));
   }
   const size_t after_fixed = kEgoStateFixedBytes - r->position();
+  // The observations end the payload, or the past-observation section follows.
   if (after_fixed > r->remaining() ||
-      static_cast<size_t>(count) * kObservationBytes != r->remaining() - after_fixed) {
+      static_cast<size_t>(count) * kObservationBytes > r->remaining() - after_fixed) {
     return Status::DataLoss("observation count " + std::to_string(count) + " needs " +
                             std::to_string(kEgoStateFixedBytes + count * kObservationBytes) +
                             " payload bytes but the payload has " +
@@ -80,6 +110,24 @@ Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* out) {
   for (int i = 0; i < count; ++i) {
     const Status s = DecodeObservation(r, &m.observations[static_cast<size_t>(i)]);
     if (!s.ok()) return s.WithContext("observations[" + std::to_string(i) + "]");
+  }
+  if (r->remaining() > 0) {
+    uint8_t past = 0;
+    SWARMLIO_RETURN_IF_ERROR(r->U8("past count", &past));
+    if (past == 0 || past > EgoStateMessage::kMaxPastObservations ||
+        size_t{past} * kPastObservationBytes != r->remaining()) {
+      return Status::DataLoss("past observation count " + std::to_string(past) +
+                              " (1.." + std::to_string(EgoStateMessage::kMaxPastObservations) +
+                              ") does not match the " + std::to_string(r->remaining()) +
+                              " bytes after it (" + std::to_string(kPastObservationBytes) +
+                              " per entry)");
+    }
+    m.past_observations.resize(past);
+    for (int i = 0; i < past; ++i) {
+      const Status s =
+          DecodePastObservation(m.p_bj_in_Gj, r, &m.past_observations[static_cast<size_t>(i)]);
+      if (!s.ok()) return s.WithContext("past_observations[" + std::to_string(i) + "]");
+    }
   }
   SWARMLIO_RETURN_IF_ERROR(r->ExpectEnd("payload"));
   *out = std::move(m);

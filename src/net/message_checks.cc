@@ -167,6 +167,30 @@ Status Check(const EgoStateMessage& m) {
     c.ObservationPosition("p_bk_in_bj", o.p_bk_in_bj);
     c.Covariance<3>("cov_p_bk_in_bj", o.cov_p_bk_in_bj);
   }
+  c.SetContext("");
+  if (m.past_observations.size() > static_cast<size_t>(EgoStateMessage::kMaxPastObservations)) {
+    c.Fail("past_observations", -1,
+           "has " + std::to_string(m.past_observations.size()) +
+               " entries, more than the maximum " +
+               std::to_string(EgoStateMessage::kMaxPastObservations));
+  }
+  // Relative to the float32 position the receiver decodes (ego_state_codec.cc).
+  const Eigen::Vector3d p_bj_sent = m.p_bj_in_Gj.cast<float>().cast<double>();
+  uint64_t seen_past = 0;
+  for (size_t i = 0; i < m.past_observations.size() && c.ok(); ++i) {
+    c.SetContext("past_observations[" + std::to_string(i) + "].");
+    const PastObservation& o = m.past_observations[i];
+    c.TeammateId("observed_id", o.observed_id, m.sender_id, &seen_past);
+    const int64_t code = o.age_ns < 0 ? -1 : PastObservationAgeCode(o.age_ns);
+    if (code < 1 || code > kPastObservationAgeMaxCode) {
+      c.Fail("age_ns", -1,
+             "= " + std::to_string(o.age_ns) + " is outside the wire range [" +
+                 std::to_string(kPastObservationAgeStepNs / 2) + ", " +
+                 std::to_string(kPastObservationAgeMaxCode * kPastObservationAgeStepNs) + ") ns");
+    }
+    c.ObservationPosition("p_bk_in_Gj - p_bj_in_Gj", o.p_bk_in_Gj - p_bj_sent);
+    c.Covariance<3>("cov_p_bk_in_Gj", o.cov_p_bk_in_Gj);
+  }
   return c.status();
 }
 

@@ -405,6 +405,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
         ++im.part.passive;
         ++im.fused_by_teammate[p.from].second;
         ++counters_.passive_fused;
+        if (p.repeated) ++counters_.passive_repeated;
       }
     }
   }

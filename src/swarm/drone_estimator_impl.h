@@ -65,6 +65,10 @@ struct DroneEstimator::Impl {
   std::vector<lio::ScanOutput> odometry_outputs;
   std::vector<DroneOutput> outputs;
   std::vector<net::SwarmMessage> messages;
+  // This scan's observations to send again with the next state message
+  // (SwarmOptions::repeat_observations), in G_i; age_ns unset.
+  std::vector<net::PastObservation> repeat;
+  int64_t repeat_stamp_ns = 0;
   // Clock synchronisation: the requests to answer when the messages are
   // taken (t3 = send time), and the newest sensor stamp ("now").
   std::unique_ptr<net::ClockSync> clock_sync;

@@ -7,6 +7,8 @@
 #include <variant>
 
 #include "drone_estimator_impl.h"
+#include "swarmlio/math/so3.h"
+#include "swarmlio/net/wire_format.h"
 
 namespace swarmlio::swarm {
 namespace {
@@ -97,6 +99,7 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
     info.restarted = true;
     info.have_message = false;
     info.identified.clear();  // its T_Gj_Gk were in its old G_j
+    info.taken_observation_stamps.clear();
     detector_->ForgetTeammate(m->sender_id);
     impl_->mutual.erase(m->sender_id);
     impl_->passive.erase(std::remove_if(impl_->passive.begin(), impl_->passive.end(),
@@ -123,8 +126,25 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   odometry.degenerate = m->degenerated;
   detector_->AddTeammateOdometry(odometry);
 
+  // j's observations of this drone: each one once, whether it comes in the
+  // message of its scan or repeated in the next (stamps on j's clock; a
+  // repeat's age travels in 0.1 ms steps).
+  const auto take = [&info](int64_t remote_stamp_ns) {
+    constexpr int64_t kTolerance = net::kPastObservationAgeStepNs / 2 + 1;
+    for (int64_t t : info.taken_observation_stamps) {
+      if (std::abs(t - remote_stamp_ns) <= kTolerance) return false;
+    }
+    info.taken_observation_stamps.push_back(remote_stamp_ns);
+    constexpr size_t kKeep = 16;
+    while (info.taken_observation_stamps.size() > kKeep) info.taken_observation_stamps.pop_front();
+    return true;
+  };
   for (const net::TeammateObservation& o : m->observations) {
     if (o.observed_id != self_id_ || !o.p_bk_in_bj.allFinite() || !o.cov_p_bk_in_bj.allFinite()) {
+      continue;
+    }
+    if (!take(received_state->stamp_ns)) {
+      ++counters_.repeats_duplicate;
       continue;
     }
     PendingPassive p;
@@ -134,9 +154,69 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
     p.cov = o.cov_p_bk_in_bj;
     p.sender = *m;
     p.sender.observations.clear();
+    p.sender.past_observations.clear();
+    impl_->passive.push_back(std::move(p));
+  }
+  for (const net::PastObservation& o : m->past_observations) {
+    if (o.observed_id != self_id_ || o.age_ns <= 0 || !o.p_bk_in_Gj.allFinite() ||
+        !o.cov_p_bk_in_Gj.allFinite()) {
+      continue;
+    }
+    if (!take(received_state->stamp_ns - o.age_ns)) {
+      ++counters_.repeats_duplicate;
+      continue;
+    }
+    // The observation already in G_j: a sender "at the origin of G_j" whose
+    // pose uncertainty is in the observation's covariance.
+    PendingPassive p;
+    p.from = m->sender_id;
+    p.repeated = true;
+    p.stamp_ns = m->stamp_ns - o.age_ns;
+    p.p_bi_in_bj = o.p_bk_in_Gj;
+    p.cov = o.cov_p_bk_in_Gj;
+    p.sender = *m;
+    p.sender.observations.clear();
+    p.sender.past_observations.clear();
+    p.sender.q_Gj_bj = Eigen::Quaterniond::Identity();
+    p.sender.p_bj_in_Gj.setZero();
+    p.sender.cov_theta_Gj_bj.setZero();
+    p.sender.cov_p_bj_in_Gj.setZero();
     impl_->passive.push_back(std::move(p));
   }
   return Status::Ok();
+}
+
+void DroneEstimator::RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,
+                                       const Eigen::MatrixXd& P) {
+  Impl& im = *impl_;
+  const RepeatObservations policy = options_.swarm.repeat_observations;
+  if (policy == RepeatObservations::kNone) return;
+  // k's position in G_i and its covariance with the own pose's:
+  //   p = R z + p_b,  dp = R dz - R [z]x dtheta + dp_b.
+  const Eigen::Matrix3d R = x.ego.R_G_b();
+  const Segment rot = ErrorStateLayout::kRotation;
+  const Segment pos = ErrorStateLayout::kPosition;
+  const Eigen::Matrix3d P_tt = P.block<3, 3>(rot.offset, rot.offset);
+  const Eigen::Matrix3d P_pp = P.block<3, 3>(pos.offset, pos.offset);
+  const Eigen::Matrix3d P_tp = P.block<3, 3>(rot.offset, pos.offset);
+  im.repeat_stamp_ns = m.stamp_ns;
+  for (const net::TeammateObservation& o : m.observations) {
+    if (policy == RepeatObservations::kDegenerateTeammates) {
+      const auto it = im.teammates.find(o.observed_id);
+      if (it == im.teammates.end() || !it->second.have_message || !it->second.last.degenerated) {
+        continue;
+      }
+    }
+    const Eigen::Matrix3d A = -R * so3::Hat(o.p_bk_in_bj);
+    Eigen::Matrix3d C = R * o.cov_p_bk_in_bj * R.transpose() + A * P_tt * A.transpose() + P_pp +
+                        A * P_tp + P_tp.transpose() * A.transpose();
+    C = 0.5 * (C + C.transpose()).eval();
+    net::PastObservation r;
+    r.observed_id = o.observed_id;
+    r.p_bk_in_Gj = R * o.p_bk_in_bj + x.ego.p_b_in_G;
+    r.cov_p_bk_in_Gj = C;
+    if (r.p_bk_in_Gj.allFinite() && C.allFinite()) im.repeat.push_back(r);
+  }
 }
 
 void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState& x,
@@ -198,6 +278,20 @@ void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState&
     m.observations.push_back(n);
   }
   im.detection.observations.clear();
+  // The previous scan's observations again, for receivers that lost them.
+  for (net::PastObservation& o : im.repeat) {
+    o.age_ns = t_k - im.repeat_stamp_ns;
+    if (o.age_ns <= 0 || net::PastObservationAgeCode(o.age_ns) > net::kPastObservationAgeMaxCode ||
+        !((o.p_bk_in_Gj - m.p_bj_in_Gj).array().abs() < 0.9 * net::kObservationPositionMaxM).all()) {
+      continue;
+    }
+    if (static_cast<int>(m.past_observations.size()) >= net::EgoStateMessage::kMaxPastObservations) {
+      break;
+    }
+    m.past_observations.push_back(o);
+  }
+  im.repeat.clear();
+  RememberForRepeat(m, x, P);
   if (m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite()) im.messages.push_back(m);
 
   // The own T_Gi_Gj estimates, every extrinsic_broadcast_period_s and right

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <map>
 
 #include "swarmlio/net/messages.h"
@@ -25,6 +26,9 @@ struct TeammateInfo {
   int64_t last_seen_ns = 0;        // last LiDAR observation (own clock)
   bool restarted = false;          // session_start changed: drop its block
   bool via_graph = false;          // its block came through a teammate's T_Gj_Gk
+  // j's clock stamps of the observations of this drone already taken (j
+  // repeats observations, SwarmOptions::repeat_observations): the newest few.
+  std::deque<int64_t> taken_observation_stamps;
   // j's own trajectory matches T_Gj_Gk, by k (from its GlobalExtrinsic
   // broadcasts; kTrajectoryMatch entries only, so derived edges never chain).
   std::map<int, net::GlobalExtrinsicEntry> identified;
@@ -57,6 +61,7 @@ void ComposeExtrinsic(const GlobalExtrinsic& T_ij, const GlobalExtrinsic& T_jk, 
 
 struct PendingPassive {
   int from = -1;
+  bool repeated = false;  // a past observation: p_bi_in_bj is in G_j, sender at identity
   int64_t stamp_ns = 0;  // when j saw this drone (j's scan end, assumed own clock)
   Eigen::Vector3d p_bi_in_bj = Eigen::Vector3d::Zero();
   Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();

@@ -62,7 +62,7 @@ void ExpectCovariance(const Eigen::Matrix<double, N, N>& sent,
 TEST(CodecPrecision, EgoStateFieldsWithinTheDocumentedPrecision) {
   for (uint64_t seed = 1; seed <= 300; ++seed) {
     SCOPED_TRACE(seed);
-    const EgoStateMessage m = MakeRawEgoState(static_cast<int>(seed % 64), 3, seed);
+    const EgoStateMessage m = MakeRawEgoState(static_cast<int>(seed % 64), 3, seed, 2);
     const EgoStateMessage d = RoundTrip(m);
     EXPECT_EQ(d.sender_id, m.sender_id);
     EXPECT_EQ(d.stamp_ns, m.stamp_ns);  // exact
@@ -82,6 +82,19 @@ TEST(CodecPrecision, EgoStateFieldsWithinTheDocumentedPrecision) {
                 0.5 * kObservationPositionStepM + 1e-12);
       ExpectCovariance<3>(m.observations[i].cov_p_bk_in_bj, d.observations[i].cov_p_bk_in_bj,
                           "cov_p_bk_in_bj");
+    }
+    ASSERT_EQ(d.past_observations.size(), m.past_observations.size());
+    for (size_t i = 0; i < m.past_observations.size(); ++i) {
+      const PastObservation& sent = m.past_observations[i];
+      const PastObservation& got = d.past_observations[i];
+      EXPECT_EQ(got.observed_id, sent.observed_id);
+      EXPECT_LE(std::abs(got.age_ns - sent.age_ns), kPastObservationAgeStepNs / 2);
+      EXPECT_EQ(got.age_ns % kPastObservationAgeStepNs, 0);
+      // Relative to the float32 position, in 2 mm steps: step / 2 plus the
+      // rounding of a few hundred metres in double.
+      EXPECT_LE((got.p_bk_in_Gj - sent.p_bk_in_Gj).cwiseAbs().maxCoeff(),
+                0.5 * kObservationPositionStepM + 1e-9);
+      ExpectCovariance<3>(sent.cov_p_bk_in_Gj, got.cov_p_bk_in_Gj, "cov_p_bk_in_Gj");
     }
   }
 }

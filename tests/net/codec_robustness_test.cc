@@ -188,11 +188,39 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
     Resign(&p);
     ExpectRejected(p, "observation count 3 needs");
   }
-  {  // trailing bytes after the declared observations
+  {  // trailing bytes after the declared observations: read as a past-observation count
     std::vector<uint8_t> p = ego;
     p.insert(p.end() - kTagBytes, 1, 0);
     Resign(&p);
-    ExpectRejected(p, "observation count 2 needs");
+    ExpectRejected(p, "past observation count 0 (1..24) does not match the 0 bytes after it");
+  }
+  {  // past observations: count against the bytes, the cap, a zero age, the sender's own id
+    const std::vector<uint8_t> past = Encode(MakeEgoState(1, 2, 5, 2));
+    const size_t count_at = kEgoFirstObservation + 2 * kObservationBytes;
+    std::vector<uint8_t> p = past;
+    Resign(&p);
+    ASSERT_TRUE(Decode(p).ok());
+    ASSERT_EQ(p[count_at], 2);
+    p[count_at] = 3;
+    Resign(&p);
+    ExpectRejected(p, "past observation count 3 (1..24) does not match the 30 bytes after it");
+    p = past;
+    p.insert(p.end() - kTagBytes, 1, 0);  // one trailing byte
+    Resign(&p);
+    ExpectRejected(p, "past observation count 2 (1..24) does not match the 31 bytes after it");
+    p = past;
+    p[count_at] = 25;
+    p.insert(p.end() - kTagBytes, 23 * kPastObservationBytes, 0);
+    Resign(&p);
+    ExpectRejected(p, "past observation count 25 (1..24)");
+    p = past;
+    PutU16(&p, count_at + 2, 0);  // the first entry's age
+    Resign(&p);
+    ExpectRejected(p, "past_observations[0]: field 'age' is 0");
+    p = past;
+    p[count_at + 1] = 1;  // the first entry observed the sender itself
+    Resign(&p);
+    ExpectRejected(p, "past_observations[0].observed_id' = 1 is the sender itself");
   }
   {  // a payload shorter than the fixed part
     std::vector<uint8_t> p = ego;

@@ -20,7 +20,7 @@ using net_test::MakeTimeSync;
 
 size_t ExpectedPacketBytes(const SwarmMessage& m) {
   if (const auto* e = std::get_if<EgoStateMessage>(&m)) {
-    return EgoStatePacketBytes(e->observations.size());
+    return EgoStatePacketBytes(e->observations.size(), e->past_observations.size());
   }
   if (const auto* g = std::get_if<GlobalExtrinsicMessage>(&m)) {
     return GlobalExtrinsicPacketBytes(g->entries.size());
@@ -63,6 +63,9 @@ TEST(PacketCodec, DocumentedSizes) {
   EXPECT_EQ(EgoStatePacketBytes(2), 111u);
   EXPECT_EQ(EgoStatePacketBytes(4), 137u);
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 397u);
+  EXPECT_EQ(EgoStatePacketBytes(1, 1), 114u);  // one observation, repeated in the next
+  EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
+                                EgoStateMessage::kMaxPastObservations), 758u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(0), 49u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 90u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 377u);

@@ -65,7 +65,8 @@ class ValueSource {
   std::mt19937_64 engine_;
 };
 
-inline EgoStateMessage MakeRawEgoState(int sender, int num_observations, uint64_t seed) {
+inline EgoStateMessage MakeRawEgoState(int sender, int num_observations, uint64_t seed,
+                                       int num_past_observations = 0) {
   ValueSource v(seed);
   EgoStateMessage m;
   m.sender_id = sender;
@@ -86,6 +87,16 @@ inline EgoStateMessage MakeRawEgoState(int sender, int num_observations, uint64_
     o.p_bk_in_bj = v.Vector32(20.0);
     o.cov_p_bk_in_bj = v.Covariance<3>(1e-3);
     m.observations.push_back(o);
+    ++i;
+  }
+  for (int i = 0, id = 0; i < num_past_observations; ++id) {
+    if (id == sender) continue;
+    PastObservation o;
+    o.observed_id = id;
+    o.age_ns = 100'000'000 + static_cast<int64_t>(v.Next() % 1'000'000'000);
+    o.p_bk_in_Gj = m.p_bj_in_Gj + v.Vector32(20.0);
+    o.cov_p_bk_in_Gj = v.Covariance<3>(1e-3);
+    m.past_observations.push_back(o);
     ++i;
   }
   return m;
@@ -136,8 +147,9 @@ Message OnTheWire(const Message& message) {
   return std::get<Message>(decoded.message);
 }
 
-inline EgoStateMessage MakeEgoState(int sender, int num_observations, uint64_t seed) {
-  return OnTheWire(MakeRawEgoState(sender, num_observations, seed));
+inline EgoStateMessage MakeEgoState(int sender, int num_observations, uint64_t seed,
+                                    int num_past_observations = 0) {
+  return OnTheWire(MakeRawEgoState(sender, num_observations, seed, num_past_observations));
 }
 
 inline GlobalExtrinsicMessage MakeGlobalExtrinsic(int sender, int num_entries, uint64_t seed) {
@@ -177,6 +189,13 @@ inline void ExpectSameMessage(const SwarmMessage& expected, const SwarmMessage& 
       EXPECT_EQ(e->observations[i].p_bk_in_bj, a.observations[i].p_bk_in_bj);
       EXPECT_EQ(e->observations[i].cov_p_bk_in_bj, a.observations[i].cov_p_bk_in_bj);
     }
+    ASSERT_EQ(e->past_observations.size(), a.past_observations.size());
+    for (size_t i = 0; i < e->past_observations.size(); ++i) {
+      EXPECT_EQ(e->past_observations[i].observed_id, a.past_observations[i].observed_id);
+      EXPECT_EQ(e->past_observations[i].age_ns, a.past_observations[i].age_ns);
+      EXPECT_EQ(e->past_observations[i].p_bk_in_Gj, a.past_observations[i].p_bk_in_Gj);
+      EXPECT_EQ(e->past_observations[i].cov_p_bk_in_Gj, a.past_observations[i].cov_p_bk_in_Gj);
+    }
   } else if (const auto* g = std::get_if<GlobalExtrinsicMessage>(&expected)) {
     const auto& a = std::get<GlobalExtrinsicMessage>(actual);
     EXPECT_EQ(g->sender_id, a.sender_id);
@@ -209,6 +228,9 @@ inline std::vector<SwarmMessage> AllExampleMessages() {
   for (int k : {0, 1, 5, EgoStateMessage::kMaxObservations}) {
     messages.push_back(MakeEgoState(3, k, 100 + static_cast<uint64_t>(k)));
   }
+  messages.push_back(MakeEgoState(3, 1, 150, 1));  // with repeated observations
+  messages.push_back(MakeEgoState(3, EgoStateMessage::kMaxObservations, 151,
+                                  EgoStateMessage::kMaxPastObservations));
   for (int n : {0, 1, GlobalExtrinsicMessage::kMaxEntries}) {
     messages.push_back(MakeGlobalExtrinsic(63, n, 200 + static_cast<uint64_t>(n)));
   }

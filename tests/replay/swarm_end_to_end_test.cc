@@ -111,6 +111,54 @@ TEST_F(SwarmEndToEndTest, LateObservationsStillHoldTheWallFacingAvia) {
   EXPECT_LT(late[0], 0.10);
 }
 
+// Observations come again, in G_j, with the observer's next state message
+// (swarm.repeat_observations). With every observation repeated ("all") and
+// 30 % of the packets lost, the Avia still fuses about as many passive
+// observations as on a lossless network (a repeat is lost too with 9 %),
+// and on the lossless network every repeat is recognised as a duplicate
+// (nothing fused twice). A defect in either direction moves the count by the
+// loss rate: 30 % fewer without repeats, more than lossless when repeats are
+// fused on top of the originals. The default repeats only the observations of
+// a degenerate teammate: the Avia, in the wall-facing part of the flight.
+TEST_F(SwarmEndToEndTest, RepeatedObservationsReplaceLostOnesAndNeverCountTwice) {
+  using swarm::RepeatObservations;
+  const auto run = [](double loss, RepeatObservations repeat) {
+    SwarmManifest manifest = *manifest_;
+    for (DroneInput& d : manifest.drones) d.swarm.repeat_observations = repeat;
+    std::unique_ptr<SwarmReplay> replay;
+    EXPECT_TRUE(SwarmReplay::Create(manifest, &replay).ok());
+    ReplayOptions options;
+    options.network.default_link.loss_probability = loss;
+    options.network.seed = 11;
+    EXPECT_TRUE(replay->Run(options).ok());
+    return replay->drone(0).estimator().counters();  // uav1, the Avia
+  };
+  const swarm::DroneEstimatorCounters lossless = run(0.0, RepeatObservations::kAll);
+  const swarm::DroneEstimatorCounters lossy = run(0.3, RepeatObservations::kAll);
+  const swarm::DroneEstimatorCounters bare = run(0.3, RepeatObservations::kNone);
+  const swarm::DroneEstimatorCounters degenerate =
+      run(0.3, RepeatObservations::kDegenerateTeammates);
+  std::printf("[ figures  ] Avia passive observations: lossless %lld (%lld repeats seen twice); "
+              "30 %% loss: %lld (%lld from repeats) repeating all, %lld (%lld) repeating those "
+              "of degenerate teammates, %lld without repeats\n",
+              static_cast<long long>(lossless.passive_fused),
+              static_cast<long long>(lossless.repeats_duplicate),
+              static_cast<long long>(lossy.passive_fused),
+              static_cast<long long>(lossy.passive_repeated),
+              static_cast<long long>(degenerate.passive_fused),
+              static_cast<long long>(degenerate.passive_repeated),
+              static_cast<long long>(bare.passive_fused));
+  EXPECT_EQ(lossless.passive_repeated, 0);
+  EXPECT_GT(lossless.repeats_duplicate, lossless.passive_fused / 2);
+  EXPECT_EQ(bare.passive_repeated, 0);
+  EXPECT_LT(bare.passive_fused, 0.8 * lossless.passive_fused);
+  EXPECT_GT(lossy.passive_repeated, lossless.passive_fused / 10);
+  EXPECT_GT(lossy.passive_fused, 0.85 * lossless.passive_fused);
+  EXPECT_LE(lossy.passive_fused, lossless.passive_fused + 5);
+  EXPECT_GT(degenerate.passive_repeated, 0);
+  EXPECT_LT(degenerate.passive_repeated, lossy.passive_repeated);
+}
+
 // The same flight with the drones' clocks 0.5 s apart and drifting (the
 // live-swarm fault of docs/network.md): each drone estimates its teammates'
 // offsets from TimeSync exchanges and maps their stamps onto its own clock,

@@ -19,7 +19,7 @@ Eigen::Matrix3d Covariance3(double scale) {
   return scale * c;
 }
 
-net::EgoStateMessage EgoState(int sender, int num_observations) {
+net::EgoStateMessage EgoState(int sender, int num_observations, int num_past = 0) {
   net::EgoStateMessage m;
   m.sender_id = sender;
   m.stamp_ns = 1'700'000'000'123'456'789;
@@ -39,6 +39,15 @@ net::EgoStateMessage EgoState(int sender, int num_observations) {
     o.p_bk_in_bj = {2.0 + id, -1.0, 0.5 * id};
     o.cov_p_bk_in_bj = Covariance3(1e-3 * (1 + id));
     m.observations.push_back(o);
+  }
+  for (int id = 0; static_cast<int>(m.past_observations.size()) < num_past; ++id) {
+    if (id == sender) continue;
+    net::PastObservation o;
+    o.observed_id = id;
+    o.age_ns = 100'000'000 + 1'000'000 * id;
+    o.p_bk_in_Gj = m.p_bj_in_Gj + Eigen::Vector3d(-3.0 + id, 2.0, 0.25 * id);
+    o.cov_p_bk_in_Gj = Covariance3(2e-3 * (1 + id));
+    m.past_observations.push_back(o);
   }
   return m;
 }
@@ -99,7 +108,8 @@ Status WriteFile(const std::string& path, const std::vector<uint8_t>& bytes) {
 
 std::vector<net::SwarmMessage> SeedMessages() {
   return {EgoState(3, 0),        EgoState(3, 1),        EgoState(3, 2),
-          EgoState(7, 5),        EgoState(63, 24),      GlobalExtrinsic(5, 0),
+          EgoState(7, 5),        EgoState(63, 24),      EgoState(3, 1, 1),
+          EgoState(9, 24, 24),   GlobalExtrinsic(5, 0),
           GlobalExtrinsic(5, 1), GlobalExtrinsic(2, 3), GlobalExtrinsic(0, 8),
           TimeSync(1, 2, false), TimeSync(2, 1, true)};
 }

@@ -1,9 +1,10 @@
 // Inter-drone messages (plain values; SI units; frames in the names, see
 // docs/conventions.md). Wire encoding and sizes: docs/network.md.
 //
-// The codec quantizes (wire version 3, docs/network.md §2.1): stamps exact,
+// The codec quantizes (wire version 4, docs/network.md §2.1): stamps exact,
 // positions float32, quaternions as smallest-three int16 codes, rates
-// float16, observation positions in 2 mm steps, covariances as 8-bit log
+// float16, observation positions in 2 mm steps, ages of past observations
+// in 0.1 ms steps, covariances as 8-bit log
 // variances and partial correlations. Decoding gives each field back within
 // that precision; the encoder reads only the upper triangle of a covariance,
 // and decoded covariances are symmetric positive definite.
@@ -32,6 +33,18 @@ struct TeammateObservation {
   Eigen::Matrix3d cov_p_bk_in_bj = Eigen::Matrix3d::Zero();  // its covariance [m^2]
 };
 
+/// An observation sender j made at an earlier scan, sent again so that a
+/// receiver that lost that scan's message still gets it (repetition against
+/// loss, docs/swarm.md "Repeated observations"). It carries no sender pose:
+/// k's position is given in G_j, its covariance includes j's pose
+/// uncertainty at that scan.
+struct PastObservation {
+  int observed_id = 0;                                       // k
+  int64_t age_ns = 0;  // stamp_ns of the message - the observation's scan end, > 0 [ns]
+  Eigen::Vector3d p_bk_in_Gj = Eigen::Vector3d::Zero();      // [m]
+  Eigen::Matrix3d cov_p_bk_in_Gj = Eigen::Matrix3d::Zero();  // [m^2]
+};
+
 /// Drone j's ego state at `stamp_ns` (j's clock), sent after every scan.
 /// The covariance blocks are the ones a receiver k needs for the active and
 /// passive observation terms and for propagating j to k's scan time with
@@ -41,6 +54,8 @@ struct TeammateObservation {
 struct EgoStateMessage {
   /// Upper bound on observations per message (keeps the packet <= 1200 B).
   static constexpr int kMaxObservations = 24;
+  /// Upper bound on past observations per message.
+  static constexpr int kMaxPastObservations = 24;
 
   int sender_id = 0;             // j
   int64_t stamp_ns = 0;          // state time, j's clock [ns]
@@ -55,6 +70,7 @@ struct EgoStateMessage {
   Eigen::Matrix3d cov_v_bj_in_Gj = Eigen::Matrix3d::Zero();     // [m^2/s^2]
   bool degenerated = false;                       // j's last scan was LiDAR-degenerate
   std::vector<TeammateObservation> observations;  // distinct ids, none == sender_id
+  std::vector<PastObservation> past_observations;  // distinct ids, none == sender_id
 };
 
 /// How the sender obtained a global extrinsic.

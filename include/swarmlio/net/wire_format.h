@@ -1,4 +1,4 @@
-// The swarm packet wire format, version 3 (docs/network.md, "Wire format").
+// The swarm packet wire format, version 4 (docs/network.md, "Wire format").
 //
 //   offset size field
 //   0      1    magic 'S' (0x53)
@@ -24,8 +24,9 @@
 namespace swarmlio::net {
 
 inline constexpr uint8_t kMagic = 0x53;  // 'S'
-/// 2: gravity in GlobalExtrinsic; 3: quantized payloads, 6-byte header, 16-byte tag.
-inline constexpr uint8_t kProtocolVersion = 3;
+/// 2: gravity in GlobalExtrinsic; 3: quantized payloads, 6-byte header, 16-byte tag;
+/// 4: past observations at the end of EgoState.
+inline constexpr uint8_t kProtocolVersion = 4;
 inline constexpr size_t kHeaderBytes = 6;
 inline constexpr size_t kTagBytes = 16;  // HMAC-SHA512-256 truncated to 128 bits
 inline constexpr size_t kPacketOverheadBytes = kHeaderBytes + kTagBytes;
@@ -70,9 +71,21 @@ constexpr size_t CovarianceBytes(size_t n) { return n + n * (n - 1) / 2; }
 //   bits u8 (0-1 q largest index, 2 degenerated, 3-7 observation count) |
 //   q_Gj_bj 3 x i16 | p_bj_in_Gj f32 x3 | v_bj_in_Gj f16 x3 | omega_bj_in_bj f16 x3 |
 //   cov_theta cov(3) | cov_p cov(3) | cov_v cov(3) |
-//   count x { observed id u8 | p_bk_in_bj 3 x i16 (2 mm) | cov(3) }
+//   count x { observed id u8 | p_bk_in_bj 3 x i16 (2 mm) | cov(3) } |
+//   optional (version 4), present only when the message has past observations:
+//   past count u8 (1..kMaxPastObservations) |
+//   past count x { observed id u8 | age u16 (0.1 ms) |
+//                  p_bk_in_Gj - p_bj_in_Gj 3 x i16 (2 mm) | cov(3) }
 inline constexpr size_t kEgoStateFixedBytes = 8 + 6 + 1 + 6 + 12 + 6 + 6 + 3 * CovarianceBytes(3);
 inline constexpr size_t kObservationBytes = 1 + 6 + CovarianceBytes(3);
+inline constexpr size_t kPastObservationBytes = 1 + 2 + 6 + CovarianceBytes(3);
+// Past observation age: uint16 code = round(age_ns / kPastObservationAgeStepNs), 1..65535.
+inline constexpr int64_t kPastObservationAgeStepNs = 100000;  // 0.1 ms
+inline constexpr int kPastObservationAgeMaxCode = 65535;      // 6.5535 s
+/// The age code the writer sends (rounded; callers check the range first).
+constexpr int64_t PastObservationAgeCode(int64_t age_ns) {
+  return (age_ns + kPastObservationAgeStepNs / 2) / kPastObservationAgeStepNs;
+}
 // GlobalExtrinsic: stamp i64 | g_in_Gi f32 x3 | cov_g_in_Gi cov(3) | count u8 |
 //   count x { teammate id u8 | bits u8 (0-1 q largest index, 2 source: 0 trajectory
 //   match, 1 graph) | q_Gi_Gj 3 x i16 | p_Gj_in_Gi f32 x3 | covariance cov(6) }
@@ -81,18 +94,22 @@ inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 6 + 12 + CovarianceBytes(
 // TimeSync: target id u8 | kind u8 (0 request, 1 response) | t1 t2 t3 i64
 inline constexpr size_t kTimeSyncBytes = 1 + 1 + 3 * 8;
 
-constexpr size_t EgoStatePacketBytes(size_t num_observations) {
-  return kPacketOverheadBytes + kEgoStateFixedBytes + kObservationBytes * num_observations;
+constexpr size_t EgoStatePacketBytes(size_t num_observations, size_t num_past_observations = 0) {
+  return kPacketOverheadBytes + kEgoStateFixedBytes + kObservationBytes * num_observations +
+         (num_past_observations > 0 ? 1 + kPastObservationBytes * num_past_observations : 0);
 }
 constexpr size_t GlobalExtrinsicPacketBytes(size_t num_entries) {
   return kPacketOverheadBytes + kGlobalExtrinsicFixedBytes + kExtrinsicEntryBytes * num_entries;
 }
 constexpr size_t TimeSyncPacketBytes() { return kPacketOverheadBytes + kTimeSyncBytes; }
 
-static_assert(kEgoStateFixedBytes == 63 && kObservationBytes == 13, "layout changed: update docs");
+static_assert(kEgoStateFixedBytes == 63 && kObservationBytes == 13 && kPastObservationBytes == 15,
+              "layout changed: update docs");
 static_assert(kGlobalExtrinsicFixedBytes == 27 && kExtrinsicEntryBytes == 41,
               "layout changed: update docs");
-static_assert(EgoStatePacketBytes(EgoStateMessage::kMaxObservations) <= kMaxPacketBytes);
+static_assert(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
+                                  EgoStateMessage::kMaxPastObservations) <= kMaxPacketBytes);
+static_assert(EgoStateMessage::kMaxPastObservations <= 255, "the past count travels in one byte");
 static_assert(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries) <= kMaxPacketBytes);
 static_assert(TimeSyncPacketBytes() <= kMaxPacketBytes);
 static_assert(EgoStateMessage::kMaxObservations < 32, "the count travels in 5 bits");

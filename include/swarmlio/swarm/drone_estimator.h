@@ -93,6 +93,8 @@ struct DroneEstimatorCounters {
   int64_t teammates_removed = 0;
   int64_t active_fused = 0;
   int64_t passive_fused = 0;
+  int64_t passive_repeated = 0;     // of passive_fused: sent again after the first message (lost)
+  int64_t repeats_duplicate = 0;    // observations of this drone received twice: used once
   int64_t gravity_fused = 0;
   int64_t observations_rejected = 0;
   int64_t front_end_errors = 0;
@@ -148,6 +150,11 @@ class DroneEstimator : public lio::ScanStageHooks {
   // Identification through teammates (docs/swarm.md): adds every k that a
   // first-hand teammate j identified and this drone has not.
   void AddTeammatesThroughTeammates(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P);
+
+  // Keeps the observations of the state message `m` that the next message
+  // repeats (SwarmOptions::repeat_observations), moved into G_i.
+  void RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,
+                         const Eigen::MatrixXd& P);
 
   int self_id_;
   DroneEstimatorOptions options_;

@@ -20,6 +20,16 @@ enum class DegeneracyPolicy {
   kEstimateAll,       // keep estimating T_Gi_Gj
 };
 
+/// Which observations a drone sends again in its next state message, for
+/// receivers that lost the message that carried them (docs/swarm.md
+/// "Repeated observations").
+enum class RepeatObservations {
+  kNone,
+  kDegenerateTeammates,  // of teammates whose last message reported a degenerate scan:
+                         // they depend on them (skip_degenerate_teammates)
+  kAll,
+};
+
 }  // namespace swarmlio::swarm
 
 namespace swarmlio::config {
@@ -28,6 +38,14 @@ struct EnumTraits<swarm::DegeneracyPolicy> {
   static constexpr std::array<std::pair<swarm::DegeneracyPolicy, const char*>, 2> kNames{{
       {swarm::DegeneracyPolicy::kFreezeExtrinsics, "freeze_extrinsics"},
       {swarm::DegeneracyPolicy::kEstimateAll, "estimate_all"},
+  }};
+};
+template <>
+struct EnumTraits<swarm::RepeatObservations> {
+  static constexpr std::array<std::pair<swarm::RepeatObservations, const char*>, 3> kNames{{
+      {swarm::RepeatObservations::kNone, "none"},
+      {swarm::RepeatObservations::kDegenerateTeammates, "degenerate_teammates"},
+      {swarm::RepeatObservations::kAll, "all"},
   }};
 };
 }  // namespace swarmlio::config
@@ -87,6 +105,10 @@ struct SwarmOptions {
   /// degenerate (the teammate's pose is not to be trusted by a drone that
   /// does not need it; a degenerate drone still fuses them).
   bool skip_degenerate_teammates = true;
+  /// Observations sent again, in G_j, with the next state message: a
+  /// receiver that lost the first message still fuses them (15 B each on
+  /// the wire; docs/swarm.md "Repeated observations").
+  RepeatObservations repeat_observations = RepeatObservations::kDegenerateTeammates;
   /// A teammate j that identified this drone (and sent its T_Gj_Gi) is
   /// added here with the inverse, without waiting for an own match
   /// (docs/swarm.md "Mutual identification").
@@ -131,6 +153,8 @@ struct SwarmOptions {
       FieldSpec::Doc("freeze_extrinsics | estimate_all, after a degenerate scan"));
     v("skip_degenerate_teammates", skip_degenerate_teammates,
       FieldSpec::Doc("do not fuse observations involving a teammate that reports degeneracy"));
+    v("repeat_observations", repeat_observations,
+      FieldSpec::Doc("none | degenerate_teammates | all: observations sent again with the next state"));
     v("mutual_identification", mutual_identification,
       FieldSpec::Doc("add a teammate that identified this drone, with the inverse of its T_Gj_Gi"));
     v("graph_identification", graph_identification,
