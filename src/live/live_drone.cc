@@ -114,6 +114,20 @@ Status LiveDrone::Create(const LiveSetup& setup, const LiveOptions& options,
   if (!status.ok()) return status.WithContext(name);
   status = im.reader->Next(&im.first, &im.has_first);
   if (!status.ok()) return status.WithContext(name);
+  if (options.start_offset_s > 0.0 && im.has_first) {
+    // A late join or a restart mid-flight: the playback starts later in the log.
+    const int64_t start_ns =
+        im.first.stamp_ns() + static_cast<int64_t>(std::llround(options.start_offset_s * 1e9));
+    while (im.has_first && im.first.stamp_ns() < start_ns) {
+      status = im.reader->Next(&im.first, &im.has_first);
+      if (!status.ok()) return status.WithContext(name);
+    }
+    if (!im.has_first) {
+      return Status::InvalidArgument(name + ": start_offset_s " +
+                                     std::to_string(options.start_offset_s) +
+                                     " s is beyond the end of the log");
+    }
+  }
   swarm::DroneEstimatorOptions estimator_options;
   estimator_options.odometry = setup.drone.odometry;
   estimator_options.teammate = setup.drone.teammate;
@@ -167,6 +181,7 @@ Status LiveDrone::Run() {
   im.mapping.clock_start_ns = im.setup.clock->NowNs();
   im.watermark_ns = im.mapping.sensor_start_ns - 1;
   im.stats.sensor_start_ns = im.mapping.sensor_start_ns;
+  im.stats.clock_start_ns = im.mapping.clock_start_ns;
   std::thread network([&im] { im.NetworkLoop(); });
   std::thread estimator([&im] { im.EstimatorLoop(); });
   std::thread input([&im] { im.InputLoop(); });

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "swarmlio/net/swarm_limits.h"
@@ -414,6 +415,28 @@ bool ClockSync::ToLocal(int teammate_id, int64_t remote_ns, int64_t* local_ns) c
 ClockSyncStats ClockSync::Stats(int teammate_id) const {
   auto it = teammates_.find(teammate_id);
   return it == teammates_.end() ? ClockSyncStats() : it->second.stats;
+}
+
+std::string FormatClockOffsets(const ClockSync& sync, int64_t now_ns,
+                               const std::vector<std::string>& names, const std::string& indent) {
+  std::string text;
+  for (int j = 0; j < kMaxSwarmSize; ++j) {
+    if (!sync.HasTeammate(j)) continue;
+    const ClockOffsetEstimate e = sync.Estimate(j, now_ns);
+    if (!e.valid) continue;
+    const ClockSyncStats st = sync.Stats(j);
+    const std::string name =
+        static_cast<size_t>(j) < names.size() ? names[static_cast<size_t>(j)] : "id" + std::to_string(j);
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "clock of %s: offset %+.3f ms (std %.3f ms, drift %+.1f ppm), %d exchanges, "
+                  "%llu requests, %llu timed out\n",
+                  name.c_str(), 1e-6 * static_cast<double>(e.offset_ns), 1e-6 * e.std_ns,
+                  e.drift_ppm, e.num_samples, static_cast<unsigned long long>(st.requests_sent),
+                  static_cast<unsigned long long>(st.requests_timed_out));
+    text += indent + line;
+  }
+  return text;
 }
 
 }  // namespace swarmlio::net

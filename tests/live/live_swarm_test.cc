@@ -301,6 +301,40 @@ TEST_F(LiveDropTest, FallingBehindDropsWholeScansNeverImu) {
   EXPECT_GT(st.imu_samples, static_cast<int64_t>(150 * kDropTestDurationS));
 }
 
+// A drone that joins late or restarts mid-flight plays its log from an
+// offset: the first played record is the first one at or after it.
+TEST_F(LiveDropTest, StartOffsetSkipsTheLogsFirstSeconds) {
+  const auto first_played = [&](double start_offset_s, Status* status) {
+    std::unique_ptr<net::SimulatedNetwork> network;
+    EXPECT_TRUE(net::SimulatedNetwork::Create(net::NetworkOptions(), {0, 1, 2}, &network).ok());
+    RacingClock clock;
+    CollectingSink sink;
+    LiveSetup setup;
+    setup.drone = manifest_->drones[0];
+    setup.drone_id = 0;
+    setup.transport = network->Endpoint(0);
+    setup.clock = &clock;
+    setup.sink = &sink;
+    LiveOptions options;
+    options.start_offset_s = start_offset_s;
+    std::unique_ptr<LiveDrone> drone;
+    *status = LiveDrone::Create(setup, options, &drone);
+    if (!status->ok()) return int64_t{0};
+    *status = drone->Run();
+    return drone->stats().sensor_start_ns;
+  };
+  Status s;
+  const int64_t from_start = first_played(0.0, &s);
+  ASSERT_TRUE(s.ok()) << s.message();
+  const int64_t from_offset = first_played(0.5, &s);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_GE(from_offset - from_start, 500'000'000);
+  EXPECT_LT(from_offset - from_start, 510'000'000);  // the next IMU sample (200 Hz)
+  first_played(kDropTestDurationS + 10.0, &s);
+  EXPECT_EQ(s.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(s.message().find("beyond the end of the log"), std::string::npos) << s.message();
+}
+
 TEST(LiveDrone, CreateRejectsBadSetupAndOptions) {
   std::unique_ptr<net::SimulatedNetwork> network;
   ASSERT_TRUE(net::SimulatedNetwork::Create(net::NetworkOptions(), {0, 1}, &network).ok());

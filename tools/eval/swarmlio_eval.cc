@@ -3,6 +3,8 @@
 //
 //   swarmlio_eval ape REF EST [--align=se3] [--relation=trans] [--plot_top_view=a.png] ...
 //   swarmlio_eval rpe REF EST [--delta=1 --delta_unit=m] ...
+//   swarmlio_eval extrinsics OBSERVER_extrinsics.csv --manifest=swarm.yaml --observer=uav1
+//     (T_Gi_Gj errors against a simulated manifest's true G frames, as the replay reports)
 //
 // REF and EST are trajectory sources: PATH (format from --format), tum:PATH,
 // kitti:PATH, euroc:PATH (EuRoC ground-truth CSV, as evo's `euroc`), or
@@ -24,6 +26,8 @@
 #include "swarmlio/eval/plots.h"
 #include "swarmlio/eval/rpe.h"
 #include "swarmlio/eval/trajectory_io.h"
+#include "swarmlio/replay/manifest.h"
+#include "extrinsic_errors.h"
 
 DEFINE_string(format, "tum", "format of sources given as a plain path: tum, kitti or euroc");
 DEFINE_string(align, "none", "alignment of the estimate onto the reference: none, se3, sim3");
@@ -50,6 +54,8 @@ DEFINE_string(lidar_topic,
 DEFINE_string(plot_top_view, "", "ape: write an x-y plot of both trajectories to this PNG");
 DEFINE_string(plot_errors, "", "ape: write the error over time to this PNG");
 DEFINE_string(table, "", "write the statistics to TABLE.md, TABLE.csv and TABLE.json");
+DEFINE_string(manifest, "", "extrinsics: the simulated swarm's manifest (true G frames)");
+DEFINE_string(observer, "", "extrinsics: the drone of --manifest that wrote the CSV");
 
 namespace {
 
@@ -148,11 +154,30 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "evo-compatible trajectory errors\n"
       "  usage: swarmlio_eval {ape|rpe} REFERENCE ESTIMATE [flags]\n"
+      "         swarmlio_eval extrinsics EXTRINSICS_CSV --manifest=M --observer=NAME\n"
       "  sources: PATH (--format), tum:PATH, kitti:PATH, euroc:PATH, bag:PATH[:TOPIC]");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
 
+  if (argc == 3 && std::string(argv[1]) == "extrinsics") {
+    if (FLAGS_manifest.empty() || FLAGS_observer.empty()) {
+      return Usage("extrinsics needs --manifest and --observer");
+    }
+    swarmlio::replay::SwarmManifest manifest;
+    Status status = swarmlio::replay::LoadManifest(FLAGS_manifest, &manifest);
+    if (!status.ok()) return Fail(status.message());
+    std::vector<swarmlio::tools::ExtrinsicErrorRow> rows;
+    status = swarmlio::tools::EvaluateExtrinsicErrors(argv[2], manifest, FLAGS_observer, &rows);
+    if (!status.ok()) return Fail(status.message());
+    std::printf("observer,teammate,estimates,first_s,last_s,end_m,end_deg,max_m,max_deg\n");
+    for (const auto& r : rows) {
+      std::printf("%s,%s,%d,%.3f,%.3f,%.4f,%.3f,%.4f,%.3f\n", FLAGS_observer.c_str(),
+                  r.teammate.c_str(), r.estimates, r.first_s, r.last_s, r.end_m, r.end_deg,
+                  r.max_m, r.max_deg);
+    }
+    return 0;
+  }
   if (argc != 4) return Usage("give a mode (ape or rpe), a reference and an estimate");
   const std::string mode = argv[1];
   if (mode != "ape" && mode != "rpe") return Usage("unknown mode '" + mode + "'");

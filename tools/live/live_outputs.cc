@@ -18,9 +18,22 @@ Status OpenFile(const std::string& path, const char* header, std::FILE** file) {
 }  // namespace
 
 Status LiveOutputs::Open(const std::string& dir, const std::string& name, bool imu_odometry,
+                         const std::vector<std::string>& drone_names,
                          std::unique_ptr<LiveOutputs>* outputs) {
   std::unique_ptr<LiveOutputs> o(new LiveOutputs());
+  o->name_ = name;
+  o->drone_names_ = drone_names;
   const std::filesystem::path base(dir);
+  o->extrinsics_path_ = (base / (name + "_extrinsics.csv")).string();
+  o->identifications_path_ = (base / (name + "_identifications.csv")).string();
+  SWARMLIO_RETURN_IF_ERROR(OpenFile(
+      o->extrinsics_path_,
+      "stamp_s,teammate,qx,qy,qz,qw,x,y,z,var_rx,var_ry,var_rz,var_x,var_y,var_z,active,passive\n",
+      &o->extrinsics_));
+  SWARMLIO_RETURN_IF_ERROR(
+      OpenFile(o->identifications_path_,
+               "observer,teammate,stamp_s,since_first_scan_s,method,mean_residual_m\n",
+               &o->identifications_));
   o->tum_path_ = (base / (name + "_tum.txt")).string();
   o->timing_path_ = (base / (name + "_timing.csv")).string();
   SWARMLIO_RETURN_IF_ERROR(
@@ -46,9 +59,33 @@ void LiveOutputs::Check(bool ok, const std::string& path) {
   if (!ok && error_.empty()) error_ = path + ": write failed: " + std::strerror(errno);
 }
 
+std::string LiveOutputs::DroneName(int id) const {
+  if (id >= 0 && static_cast<size_t>(id) < drone_names_.size()) return drone_names_[id];
+  return "id" + std::to_string(id);
+}
+
 void LiveOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& latency) {
   const EgoState& x = o.ego.state;
   const double t_s = StampSeconds(o.ego.stamp_ns);
+  if (first_scan_s_ < 0.0) first_scan_s_ = t_s;
+  for (const swarm::IdentificationEvent& e : o.identifications) {
+    Check(std::fprintf(identifications_, "%s,%s,%.6f,%.6f,%s,%.6g\n", name_.c_str(),
+                       DroneName(e.drone_id).c_str(), StampSeconds(e.stamp_ns),
+                       StampSeconds(e.stamp_ns) - first_scan_s_, e.method.c_str(),
+                       e.mean_residual_m) > 0,
+          identifications_path_);
+  }
+  for (const swarm::TeammateEstimate& e : o.teammates) {
+    const Eigen::Quaterniond& q = e.T_Gi_Gj.q_Gi_Gj;
+    const Eigen::Vector3d& p = e.T_Gi_Gj.p_Gj_in_Gi;
+    const auto& C = e.extrinsic_covariance;
+    Check(std::fprintf(extrinsics_,
+                       "%.9f,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d\n",
+                       t_s, DroneName(e.drone_id).c_str(), q.x(), q.y(), q.z(), q.w(), p.x(),
+                       p.y(), p.z(), C(0, 0), C(1, 1), C(2, 2), C(3, 3), C(4, 4), C(5, 5),
+                       e.active_observations, e.passive_observations) > 0,
+          extrinsics_path_);
+  }
   Check(std::fprintf(tum_, "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", t_s,
                      x.p_b_in_G.x(), x.p_b_in_G.y(), x.p_b_in_G.z(), x.q_G_b.x(), x.q_G_b.y(),
                      x.q_G_b.z(), x.q_G_b.w()) > 0,
@@ -83,8 +120,10 @@ void LiveOutputs::OnImuPose(const live::ImuRatePose& p) {
 }
 
 Status LiveOutputs::Close() {
-  for (auto [file, path] : {std::pair{&tum_, &tum_path_}, std::pair{&timing_, &timing_path_},
-                            std::pair{&imu_, &imu_path_}}) {
+  for (auto [file, path] :
+       {std::pair{&tum_, &tum_path_}, std::pair{&timing_, &timing_path_},
+        std::pair{&imu_, &imu_path_}, std::pair{&extrinsics_, &extrinsics_path_},
+        std::pair{&identifications_, &identifications_path_}}) {
     if (*file == nullptr) continue;
     Check(std::fclose(*file) == 0, *path);
     *file = nullptr;

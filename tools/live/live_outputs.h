@@ -4,6 +4,9 @@
 //   <name>_timing.csv    per scan: counts, stage total, latency scan end -> odometry out;
 //                        a dropped scan is a row with `dropped` = queue | backlog
 //   <name>_imu_odom.csv  the IMU-rate propagated state (one row per IMU sample)
+//   <name>_extrinsics.csv  per scan and teammate in the state: T_Gi_Gj, its covariance
+//                        diagonal, observations fused (the replay's columns)
+//   <name>_identifications.csv  every identification (the replay's columns)
 #pragma once
 
 #include <cstdio>
@@ -19,7 +22,10 @@ namespace swarmlio::tools {
 class LiveOutputs : public live::LiveSink {
  public:
   /// Creates the files in `dir`; `imu_odometry` false: no IMU-rate file.
+  /// `drone_names[id]` names the teammates in the swarm files (ids without a
+  /// name are written as "id<N>").
   static Status Open(const std::string& dir, const std::string& name, bool imu_odometry,
+                     const std::vector<std::string>& drone_names,
                      std::unique_ptr<LiveOutputs>* outputs);
   ~LiveOutputs() override;
 
@@ -38,11 +44,17 @@ class LiveOutputs : public live::LiveSink {
  private:
   LiveOutputs() = default;
   void Check(bool ok, const std::string& path);
+  std::string DroneName(int id) const;
 
-  std::string tum_path_, timing_path_, imu_path_;
+  std::string name_;
+  std::vector<std::string> drone_names_;
+  double first_scan_s_ = -1.0;
+  std::string tum_path_, timing_path_, imu_path_, extrinsics_path_, identifications_path_;
   std::FILE* tum_ = nullptr;
   std::FILE* timing_ = nullptr;
   std::FILE* imu_ = nullptr;
+  std::FILE* extrinsics_ = nullptr;
+  std::FILE* identifications_ = nullptr;
   std::vector<float> latencies_ms_;
   int64_t imu_poses_ = 0;
   int64_t first_imu_pose_ns_ = 0;

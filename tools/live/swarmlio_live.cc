@@ -48,6 +48,7 @@ DEFINE_string(interface_address, "0.0.0.0",
               "multicast: interface to join and send on; unicast: address to bind");
 DEFINE_string(broadcast_address, "255.255.255.255", "broadcast mode destination");
 DEFINE_double(rate, 1.0, "playback speed (1 = real time)");
+DEFINE_double(start_s, 0.0, "skip the log's first seconds (a drone joining late or restarting)");
 DEFINE_double(max_scan_backlog_s, 0.3, "a scan taken later than this behind playback is dropped");
 DEFINE_int32(max_queued_scans, 4, "scans waiting for the estimator at most; more are dropped");
 DEFINE_double(network_poll_period_ms, 2.0, "UDP poll period [ms]");
@@ -214,6 +215,7 @@ int Main() {
   if (!status.ok()) return Fail(status);
   live::LiveOptions options;
   options.rate = FLAGS_rate;
+  options.start_offset_s = FLAGS_start_s;
   options.max_scan_backlog_s = FLAGS_max_scan_backlog_s;
   options.max_queued_scans = FLAGS_max_queued_scans;
   options.network_poll_period_ms = FLAGS_network_poll_period_ms;
@@ -226,7 +228,9 @@ int Main() {
   status = net::UdpTransport::Create(udp_options, drone_id, &udp);
   if (!status.ok()) return Fail(status);
   std::unique_ptr<LiveOutputs> outputs;
-  status = LiveOutputs::Open(FLAGS_output_dir, drone.name, FLAGS_imu_odom, &outputs);
+  std::vector<std::string> drone_names;
+  for (const replay::DroneInput& d : manifest.drones) drone_names.push_back(d.name);
+  status = LiveOutputs::Open(FLAGS_output_dir, drone.name, FLAGS_imu_odom, drone_names, &outputs);
   if (!status.ok()) return Fail(status);
   live::SteadyClock clock;
   setup.drone = drone;
@@ -259,7 +263,19 @@ int Main() {
   finished = true;
   watcher.join();
   const Status closed = outputs->Close();
-  const std::string summary = Summary(drone.name, live->stats(), *live, *outputs, udp->stats());
+  std::string summary = Summary(drone.name, live->stats(), *live, *outputs, udp->stats());
+  {
+    const live::LiveStats& st = live->stats();
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "  playback: sensor stamp %lld ns at steady clock %lld ns, rate %.6g\n",
+                  static_cast<long long>(st.sensor_start_ns),
+                  static_cast<long long>(st.clock_start_ns), FLAGS_rate);
+    summary += line;
+    if (const net::ClockSync* sync = live->estimator().clock_sync()) {
+      summary += net::FormatClockOffsets(*sync, st.sensor_end_ns, drone_names, "  ");
+    }
+  }
   std::printf("%s", summary.c_str());
   const std::string summary_path =
       (std::filesystem::path(FLAGS_output_dir) / (drone.name + "_live_summary.txt")).string();

@@ -340,17 +340,9 @@ int Main() {
       if (const net::ClockSync* sync = run->drone(i).estimator().clock_sync()) {
         const auto& scans = run->drone(i).scans();
         const int64_t now_ns = scans.empty() ? 0 : scans.back().stamp_ns;
-        for (int j = 0; j < run->num_drones(); ++j) {
-          const net::ClockOffsetEstimate e = sync->Estimate(j, now_ns);
-          if (j == i || !e.valid) continue;
-          const net::ClockSyncStats st = sync->Stats(j);
-          std::printf("  clock of %s: offset %+.3f ms (std %.3f ms, drift %+.1f ppm), %d exchanges, "
-                      "%llu requests, %llu timed out\n",
-                      run->drone(j).input().name.c_str(), 1e-6 * static_cast<double>(e.offset_ns),
-                      1e-6 * e.std_ns, e.drift_ppm, e.num_samples,
-                      static_cast<unsigned long long>(st.requests_sent),
-                      static_cast<unsigned long long>(st.requests_timed_out));
-        }
+        std::vector<std::string> names;
+        for (int j = 0; j < run->num_drones(); ++j) names.push_back(run->drone(j).input().name);
+        std::printf("%s", net::FormatClockOffsets(*sync, now_ns, names, "  ").c_str());
       }
     }
   }

@@ -68,6 +68,10 @@ struct LiveStats {
   int64_t sensor_start_ns = 0;       // first record's stamp
   int64_t sensor_end_ns = 0;         // last record's stamp
   int64_t clock_elapsed_ns = 0;      // whole run on the clock
+  int64_t clock_start_ns = 0;        // Clock::NowNs() when the first record played: with
+                                     // sensor_start_ns and the rate, the playback's mapping
+                                     // (processes on one machine share the steady clock, so
+                                     // their true clock offsets follow, docs/online.md)
 };
 
 class LiveDrone {

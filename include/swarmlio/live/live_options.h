@@ -18,6 +18,9 @@ struct LiveOptions {
   int message_queue_capacity = 1024;   // network -> estimator: received messages
   int outbox_capacity = 256;           // estimator -> network: messages to send
   bool imu_rate_odometry = true;       // propagate the state at every IMU sample
+  double start_offset_s = 0.0;         // skip the log's first seconds: playback starts at the
+                                       // first record this far after the log's first (a drone
+                                       // that joins late or restarts mid-flight) [s]
 
   template <class V>
   void VisitFields(V&& v) {
@@ -38,6 +41,8 @@ struct LiveOptions {
       FieldSpec::InRange(1, 1 << 20, "", "messages queued for sending"));
     v("imu_rate_odometry", imu_rate_odometry,
       FieldSpec::Doc("propagated pose at every IMU sample (flight controller feed)"));
+    v("start_offset_s", start_offset_s,
+      FieldSpec::InRange(0.0, 1e6, "s", "skip the log's first seconds (late join, restart)"));
   }
   /// "" when valid, else "key: reason".
   std::string Validate() const { return config::ValidateFields(*this); }

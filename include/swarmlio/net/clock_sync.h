@@ -248,4 +248,11 @@ class ClockSync {
   uint64_t requests_answered_ = 0;
 };
 
+/// One line per synchronised teammate at local time `now_ns`, for the
+/// tools' summaries: "clock of <name>: offset +x.xxx ms (std ..., drift ...),
+/// N exchanges, R requests, T timed out". `names[id]` names a teammate
+/// ("id<N>" beyond it); each line starts with `indent`.
+std::string FormatClockOffsets(const ClockSync& sync, int64_t now_ns,
+                               const std::vector<std::string>& names, const std::string& indent);
+
 }  // namespace swarmlio::net

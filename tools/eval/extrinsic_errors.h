@@ -1,0 +1,35 @@
+// Extrinsic error of an observer's T_Gi_Gj estimates over time against the
+// true global frames of a simulated swarm (`swarmlio_eval extrinsics`): reads
+// an `<observer>_extrinsics.csv` written by swarmlio_replay or swarmlio_live
+// and the manifest whose drones carry their G frames in the simulation world
+// (p_G_in_W_m, q_W_G_xyzw). The same definitions as the replay's swarm
+// report (docs/replay.md "Swarm outputs"). Tool-side: reads files.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "swarmlio/common/status.h"
+#include "swarmlio/replay/manifest.h"
+
+namespace swarmlio::tools {
+
+struct ExtrinsicErrorRow {
+  std::string teammate;
+  int estimates = 0;       // rows of the CSV for this teammate
+  double first_s = 0.0;    // stamp of the first estimate (identification) [s]
+  double last_s = 0.0;     // stamp of the last estimate [s]
+  double end_m = 0.0;      // |p_Gj_in_Gi - truth| at the last estimate [m]
+  double end_deg = 0.0;    // rotation error at the last estimate [deg]
+  double max_m = 0.0;      // over all estimates
+  double max_deg = 0.0;
+};
+
+/// One row per teammate in the file, in order of first appearance. Errors
+/// name the file and line; a teammate not in the manifest is an error.
+Status EvaluateExtrinsicErrors(const std::string& csv_path,
+                               const replay::SwarmManifest& manifest,
+                               const std::string& observer,
+                               std::vector<ExtrinsicErrorRow>* rows);
+
+}  // namespace swarmlio::tools
