@@ -7,10 +7,12 @@
 #
 #   tools/run_live_swarm.sh                          # indoor_3uav, rate 1, realistic preset
 #   SCENARIO=wall_degenerate RATE=2 OUT=/tmp/live tools/run_live_swarm.sh
-#   PROXY="--loss 0.3 --delay_s 0.2 --jitter_s 0.02 --reorder_probability 0.1" \
-#     START_DELAYS="0.5 0 1.0" JOIN=uav3=20 RESTART=uav2=30 tools/run_live_swarm.sh   # faults
+#   PROXY="--loss 0.3 --delay_s 0.2 --jitter_s 0.01 --reorder_probability 0.1" \
+#     CLOCK_OFFSETS=0,0.5,-0.5 JOIN=uav3=20 RESTART=uav2=30 OUT=/tmp/faults tools/run_live_swarm.sh
 #
 # Environment: SCENARIO (indoor_3uav), RATE (1), IMPERFECTIONS (realistic), SEED (the file's),
+# CLOCK_OFFSETS (the drones' clock offsets for the simulation, e.g. "0,0.5,-0.5"), LIVE_ARGS
+# (more swarmlio_live flags, e.g. "--network_poll_period_ms=0.5"),
 # UDP_MODE (unicast: multicast needs a route on loopback), BASE_PORT (9100), OUT
 # (results/live/<scenario>), BUILD_DIR (build). Exit code 1 if a step fails; the comparison
 # is printed, not judged.
@@ -37,6 +39,7 @@ mkdir -p "$OUT"
 if [[ ! -f "$OUT/sim/swarm.yaml" ]]; then
   seed_flag=()
   [[ -n "${SEED:-}" ]] && seed_flag=(--seed "$SEED")
+  [[ -n "${CLOCK_OFFSETS:-}" ]] && seed_flag+=(--clock_offsets_s "$CLOCK_OFFSETS")
   "$SIM" --scenario "$ROOT/configs/scenarios/$SCENARIO.yaml" --imperfections "$IMPERFECTIONS" \
       "${seed_flag[@]}" --output_dir "$OUT/sim" > "$OUT/sim.log" 2>&1 ||
     { echo "simulation failed: $OUT/sim.log" >&2; exit 1; }
@@ -55,12 +58,13 @@ echo "offline replay of $SCENARIO ..."
 
 echo "live: ${#drones[@]} processes at rate $RATE ($UDP_MODE)${PROXY:+, through swarmlio_net_proxy $PROXY} ..."
 # Faults (docs/online.md "Faults"): PROXY routes every datagram through a lossy relay;
-# START_DELAYS staggers the starts (a process started d s later has a sensor clock d s
-# behind); JOIN=name=S starts that drone S s late, its log from S s on; RESTART=name=S kills it
-# S s into the run and starts it again at once, its log from there (output in live_restart/).
-delays=(${START_DELAYS:-})
-join_name="${JOIN%%=*}"; join_s="${JOIN#*=}"
-restart_name="${RESTART%%=*}"; restart_s="${RESTART#*=}"
+# JOIN=name=S starts that drone S s late, its log from S s on; RESTART=name=S kills it S s into
+# the run and starts it again 1 s later, its log from there (output in live_restart/). Every
+# process starts its playback at a common wall-clock time (--start_at_unix_s), so the logs,
+# recorded simultaneously, are played simultaneously; clock offsets between the drones are
+# the simulator's (CLOCK_OFFSETS at simulation time).
+join_name="${JOIN:-}"; join_name="${join_name%%=*}"; join_s="${JOIN:-}"; join_s="${join_s#*=}"
+restart_name="${RESTART:-}"; restart_name="${restart_name%%=*}"; restart_s="${RESTART:-}"; restart_s="${restart_s#*=}"
 peers=""
 for i in "${!drones[@]}"; do
   port=$((BASE_PORT + i + 1))
@@ -75,42 +79,45 @@ if [[ -n "${PROXY:-}" ]]; then
   "$PROXY_TOOL" --routes "$routes" $PROXY > "$OUT/proxy.log" 2>&1 &
   proxy_pid=$!
 fi
-launch() {  # launch <index> <output dir> <start_s> <log suffix>: starts one drone (pid in LAUNCHED)
+launch() {  # launch <index> <output dir> <log offset s> <wall start> <log suffix> (pid in LAUNCHED)
   local i=$1 name="${drones[$1]}"
   local args=(--manifest "$OUT/sim/swarm.yaml" --drone "$name" --key_file "$key" --rate "$RATE"
-              --output_dir "$2" --imu_odom=false --udp_mode "$UDP_MODE" --start_s "$3")
+              --output_dir "$2" --imu_odom=false --udp_mode "$UDP_MODE" --start_s "$3"
+              --start_at_unix_s "$4" ${LIVE_ARGS:-})
   if [[ "$UDP_MODE" == unicast ]]; then
     args+=(--port "$((BASE_PORT + i + 1))" --peers "$peers")
   else
     args+=(--port "$BASE_PORT")
   fi
-  "$LIVE" "${args[@]}" > "$OUT/live_$name$4.log" 2>&1 &
+  "$LIVE" "${args[@]}" > "$OUT/live_$name$5.log" 2>&1 &
   LAUNCHED=$!
 }
+sleep_until() { awk -v t="$1" -v now="$(date +%s.%N)" 'BEGIN { w = t - now; if (w > 0) system("sleep " w) }'; }
+plus() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", a + b }'; }
+times() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", a * b }'; }
 mkdir -p "$OUT/live" "$OUT/live_restart"
-t0=$(date +%s.%N)
+t0=$(plus "$(date +%s.%N)" 3)  # every process has opened its log by then
 pids=()
-order=()
-for i in "${!drones[@]}"; do order+=("${delays[$i]:-0} $i"); done
-while read -r delay i; do
-  name="${drones[$i]}"
-  start_s=0
-  if [[ "$name" == "$join_name" ]]; then delay=$join_s; start_s=$(awk -v s="$join_s" -v r="$RATE" 'BEGIN { print s * r }'); fi
-  awk -v t0="$t0" -v d="$delay" -v now="$(date +%s.%N)" 'BEGIN { w = t0 + d - now; if (w > 0) system("sleep " w) }'
-  launch "$i" "$OUT/live" "$start_s" ""
+for i in "${!drones[@]}"; do
+  [[ "${drones[$i]}" == "$join_name" ]] && { join_index=$i; continue; }
+  launch "$i" "$OUT/live" 0 "$t0" ""
   pids[$i]=$LAUNCHED
-done < <(printf '%s\n' "${order[@]}" | sort -n)
+done
+if [[ -n "${JOIN:-}" ]]; then  # (a RESTART is assumed to come after the JOIN)
+  sleep_until "$(plus "$t0" "$(plus "$join_s" -2)")"  # opens its log, then waits for its start
+  launch "$join_index" "$OUT/live" "$(times "$join_s" "$RATE")" "$(plus "$t0" "$join_s")" ""
+  pids[$join_index]=$LAUNCHED
+fi
 if [[ -n "${RESTART:-}" ]]; then
   for i in "${!drones[@]}"; do [[ "${drones[$i]}" == "$restart_name" ]] && restart_index=$i; done
-  awk -v t0="$t0" -v d="$restart_s" -v now="$(date +%s.%N)" 'BEGIN { w = t0 + d - now; if (w > 0) system("sleep " w) }'
+  sleep_until "$(plus "$t0" "$restart_s")"
   kill -9 "${pids[$restart_index]}" 2> /dev/null || true
   wait "${pids[$restart_index]}" 2> /dev/null || true
-  offset=$(awk -v t0="$t0" -v now="$(date +%s.%N)" -v d="${delays[$restart_index]:-0}" -v r="$RATE" \
-           'BEGIN { printf "%.3f", (now - t0 - d) * r }')
-  echo "killed $restart_name at ${restart_s} s; restarted with its log from ${offset} s"
-  launch "$restart_index" "$OUT/live_restart" "$offset" "_restart"
+  restart_at=$(plus "$restart_s" 1)  # down for a second
+  echo "killed $restart_name ${restart_s} s into the run; back at ${restart_at} s, its log from there"
+  launch "$restart_index" "$OUT/live_restart" "$(times "$restart_at" "$RATE")" \
+      "$(plus "$t0" "$restart_at")" "_restart"
   pids[$restart_index]=$LAUNCHED
-  restart_at=$(awk -v t0="$t0" -v now="$(date +%s.%N)" 'BEGIN { printf "%.3f", now - t0 }')
 fi
 failed=0
 for i in "${!pids[@]}"; do
@@ -146,6 +153,15 @@ for name in "${drones[@]}"; do
       "$p95" "$dropped"
 done
 
+# A drone that joined late or restarted has its G at its body pose when its odometry
+# initialized (docs/conventions.md): the extrinsic truth follows it.
+origins=""
+for name in "${drones[@]}"; do
+  if [[ ( -n "${JOIN:-}" && "$name" == "$join_name" ) || ( -n "${RESTART:-}" && "$name" == "$restart_name" ) ]]; then
+    stamp=$(summary_value "$name" 's/.*odometry initialized at sensor stamp ([0-9]+) ns.*/\1/p')
+    origins+="${origins:+,}$name=$(awk -v s="$stamp" 'BEGIN { printf "%.9f", s * 1e-9 }')"
+  fi
+done
 echo
 echo "| observer | teammate | identified offline / live [s after first scan] | extrinsic end offline [m / deg] | live [m / deg] | live - offline [m] |"
 echo "|---|---|---:|---:|---:|---:|"
@@ -154,7 +170,7 @@ for name in "${drones[@]}"; do
   "$EVAL" extrinsics "$OUT/offline/${name}_extrinsics.csv" --manifest "$OUT/sim/swarm.yaml" \
       --observer "$name" | tail -n +2 > "$OUT/offline_${name}_extrinsics_errors.csv"
   "$EVAL" extrinsics "$dir/${name}_extrinsics.csv" --manifest "$OUT/sim/swarm.yaml" \
-      --observer "$name" | tail -n +2 > "$OUT/live_${name}_extrinsics_errors.csv"
+      --observer "$name" --origins "$origins" | tail -n +2 > "$OUT/live_${name}_extrinsics_errors.csv"
   for teammate in "${drones[@]}"; do
     [[ "$teammate" == "$name" ]] && continue
     o=$(awk -F, -v t="$teammate" '$2 == t' "$OUT/offline_${name}_extrinsics_errors.csv")
@@ -177,13 +193,13 @@ for name in "${drones[@]}"; do
 done
 if [[ -n "${RESTART:-}" ]]; then
   echo
-  echo "$restart_name restarted ${restart_at} s into the run; its teammates identified it again after (s):"
+  echo "$restart_name back ${restart_at} s into the run; its teammates identified it again after:"
   for i in "${!drones[@]}"; do
     name="${drones[$i]}"
     [[ "$name" == "$restart_name" ]] && continue
-    # The observer's log time of the restart: (restart - its start delay) x rate.
-    awk -F, -v t="$restart_name" -v at="$restart_at" -v d="${delays[$i]:-0}" -v r="$RATE" -v o="$name" '
-      NR > 1 && $2 == t && $4 > (at - d) * r { printf "  %s: %.1f s (%s)\n", o, $4 - (at - d) * r, $5; found = 1; exit }
+    # The observer's log time of the restart: restart_at x rate.
+    awk -F, -v t="$restart_name" -v at="$restart_at" -v r="$RATE" -v o="$name" '
+      NR > 1 && $2 == t && $4 > at * r { printf "  %s: %.1f s (%s)\n", o, $4 - at * r, $5; found = 1; exit }
       END { if (!found) printf "  %s: not identified again\n", o }' "$OUT/live/${name}_identifications.csv"
   done
 fi

@@ -28,6 +28,18 @@ using internal::TeammateInfo;
 
 }  // namespace
 
+bool DroneEstimator::MadeInThisSession(int sender_id, int64_t sender_stamp_ns) const {
+  if (!odometry_->initialized()) return false;
+  int64_t local_ns = sender_stamp_ns;
+  if (impl_->clock_sync != nullptr &&
+      !impl_->clock_sync->ToLocal(sender_id, sender_stamp_ns, &local_ns)) {
+    return false;  // its clock is not known yet
+  }
+  const int64_t margin_ns =
+      static_cast<int64_t>(std::llround(options_.swarm.max_message_age_s * 1e9));
+  return local_ns >= odometry_->initialization().stamp_ns + margin_ns;
+}
+
 Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   ++counters_.messages_received;
   if (const auto* t = std::get_if<net::TimeSyncMessage>(&received.message)) {
@@ -54,7 +66,14 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
         continue;
       }
       if (e.teammate_id == self_id_) {
-        impl_->mutual[g->sender_id] = PendingMutual{e};
+        // The sender's T_Gj_Gi is about this drone's G only if made in this
+        // session: after a restart, teammates keep broadcasting the old one
+        // until they hear the new session (its first states, one latency).
+        if (MadeInThisSession(g->sender_id, g->stamp_ns)) {
+          impl_->mutual[g->sender_id] = PendingMutual{e};
+        } else {
+          ++counters_.extrinsics_stale;
+        }
       } else if (e.source == net::ExtrinsicSource::kTrajectoryMatch) {
         impl_->teammates[g->sender_id].identified[e.teammate_id] = e;
       }

@@ -481,6 +481,45 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
   const Eigen::Isometry3d T_true =
       ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
   EXPECT_LT((last.teammates[0].T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm(), 0.03);
+  EXPECT_EQ(run.estimator->counters().extrinsics_stale, 0);
+}
+
+// After a restart, teammates still broadcast their T_Gj_Gi of the previous
+// session for a moment: an entry naming this drone that was made before its
+// session began (by max_message_age_s) is not a mutual identification.
+TEST(DroneEstimator, IgnoresTeammatesExtrinsicsOfItsPreviousSession) {
+  sim::Scenario scenario = IndoorScenario();
+  const sim::DroneConfig& d = scenario.drones[0];
+  DroneEstimatorOptions o = OptionsFor(d);
+  o.swarm.synchronize_clocks = false;  // stamps taken as own-clock stamps
+  std::unique_ptr<DroneEstimator> e;
+  ASSERT_TRUE(DroneEstimator::Create(0, o, d.lidar.sensor, &e).ok());
+  const int64_t t0 = 1'000'000'000'000;
+  ImuSample imu;
+  imu.linear_acceleration = Eigen::Vector3d(0, 0, 9.81);
+  for (int k = 0; k < 400 && !e->odometry().initialized(); ++k) {
+    imu.stamp_ns = t0 + k * 5'000'000;
+    ASSERT_TRUE(e->AddImu(imu).ok());
+  }
+  ASSERT_TRUE(e->odometry().initialized());
+  const int64_t session_ns = e->odometry().initialization().stamp_ns;
+  net::GlobalExtrinsicMessage g;
+  g.sender_id = 1;
+  net::GlobalExtrinsicEntry entry;
+  entry.teammate_id = 0;
+  entry.covariance = 1e-4 * Eigen::Matrix<double, 6, 6>::Identity();
+  g.entries.push_back(entry);
+  net::ReceivedMessage received;
+  received.arrival_ns = session_ns + 100'000'000;
+  g.stamp_ns = session_ns + 100'000'000;  // within max_message_age_s of the session start
+  received.message = g;
+  ASSERT_TRUE(e->AddMessage(received).ok());
+  EXPECT_EQ(e->counters().extrinsics_stale, 1);
+  g.stamp_ns = session_ns + 600'000'000;  // after it: this session's
+  received.arrival_ns = g.stamp_ns;
+  received.message = g;
+  ASSERT_TRUE(e->AddMessage(received).ok());
+  EXPECT_EQ(e->counters().extrinsics_stale, 1);
 }
 
 // Identification through teammates: teammate 1 identifies the observer (its

@@ -6,6 +6,7 @@
 // report (docs/replay.md "Swarm outputs"). Tool-side: reads files.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -27,9 +28,14 @@ struct ExtrinsicErrorRow {
 
 /// One row per teammate in the file, in order of first appearance. Errors
 /// name the file and line; a teammate not in the manifest is an error.
+/// `origins`: drones whose estimator started later than the simulation (a
+/// late join, a restart) have their global frame at their body pose at that
+/// stamp (the IMU initialization, docs/conventions.md), taken from their
+/// ground-truth TUM file: name -> stamp [s, the drone's clock].
 Status EvaluateExtrinsicErrors(const std::string& csv_path,
                                const replay::SwarmManifest& manifest,
                                const std::string& observer,
+                               const std::map<std::string, double>& origins,
                                std::vector<ExtrinsicErrorRow>* rows);
 
 }  // namespace swarmlio::tools

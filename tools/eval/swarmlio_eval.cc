@@ -18,7 +18,11 @@
 #include <glog/logging.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "swarmlio/eval/ape.h"
 #include "swarmlio/eval/bag_trajectory.h"
@@ -56,6 +60,9 @@ DEFINE_string(plot_errors, "", "ape: write the error over time to this PNG");
 DEFINE_string(table, "", "write the statistics to TABLE.md, TABLE.csv and TABLE.json");
 DEFINE_string(manifest, "", "extrinsics: the simulated swarm's manifest (true G frames)");
 DEFINE_string(observer, "", "extrinsics: the drone of --manifest that wrote the CSV");
+DEFINE_string(origins, "",
+              "extrinsics: name=stamp_s,... drones whose estimator started late (join, restart): "
+              "their G is their true body pose at that stamp (their IMU initialization)");
 
 namespace {
 
@@ -167,8 +174,21 @@ int main(int argc, char** argv) {
     swarmlio::replay::SwarmManifest manifest;
     Status status = swarmlio::replay::LoadManifest(FLAGS_manifest, &manifest);
     if (!status.ok()) return Fail(status.message());
+    std::map<std::string, double> origins;
+    std::stringstream list(FLAGS_origins);
+    std::string item;
+    while (std::getline(list, item, ',')) {
+      const size_t eq = item.find('=');
+      char* end = nullptr;
+      const double stamp_s = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
+      if (eq == std::string::npos || end == item.c_str() + eq + 1 || *end != '\0') {
+        return Usage("--origins: '" + item + "' is not name=stamp_s");
+      }
+      origins[item.substr(0, eq)] = stamp_s;
+    }
     std::vector<swarmlio::tools::ExtrinsicErrorRow> rows;
-    status = swarmlio::tools::EvaluateExtrinsicErrors(argv[2], manifest, FLAGS_observer, &rows);
+    status = swarmlio::tools::EvaluateExtrinsicErrors(argv[2], manifest, FLAGS_observer, origins,
+                                                      &rows);
     if (!status.ok()) return Fail(status.message());
     std::printf("observer,teammate,estimates,first_s,last_s,end_m,end_deg,max_m,max_deg\n");
     for (const auto& r : rows) {

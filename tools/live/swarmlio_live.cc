@@ -12,6 +12,7 @@
 #include <gflags/gflags.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -49,6 +50,9 @@ DEFINE_string(interface_address, "0.0.0.0",
 DEFINE_string(broadcast_address, "255.255.255.255", "broadcast mode destination");
 DEFINE_double(rate, 1.0, "playback speed (1 = real time)");
 DEFINE_double(start_s, 0.0, "skip the log's first seconds (a drone joining late or restarting)");
+DEFINE_double(start_at_unix_s, 0.0,
+              "start the playback at this wall-clock time (UNIX seconds; 0: at once): processes "
+              "started together play the same instant of their logs together");
 DEFINE_double(max_scan_backlog_s, 0.3, "a scan taken later than this behind playback is dropped");
 DEFINE_int32(max_queued_scans, 4, "scans waiting for the estimator at most; more are dropped");
 DEFINE_double(network_poll_period_ms, 2.0, "UDP poll period [ms]");
@@ -181,9 +185,15 @@ std::string Summary(const std::string& name, const live::LiveStats& s,
   std::string text = buffer;
   const swarm::DroneEstimatorCounters& c = drone.estimator().counters();
   std::snprintf(buffer, sizeof(buffer),
-                "  swarm: %lld identifications, %lld active + %lld passive observations fused\n",
+                "  swarm: %lld identifications, %lld active + %lld passive observations fused "
+                "(%lld repeats), %lld gravity; teammates restarted %lld, removed %lld; states "
+                "waiting for a clock offset %lld, ignored %lld\n",
                 static_cast<long long>(c.identifications), static_cast<long long>(c.active_fused),
-                static_cast<long long>(c.passive_fused));
+                static_cast<long long>(c.passive_fused), static_cast<long long>(c.passive_repeated),
+                static_cast<long long>(c.gravity_fused), static_cast<long long>(c.teammate_restarts),
+                static_cast<long long>(c.teammates_removed),
+                static_cast<long long>(c.messages_unsynchronized),
+                static_cast<long long>(c.messages_ignored));
   return text + buffer;
 }
 
@@ -259,6 +269,16 @@ int Main() {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   });
+  if (FLAGS_start_at_unix_s > 0.0) {
+    const auto start = std::chrono::system_clock::time_point(
+        std::chrono::duration_cast<std::chrono::system_clock::duration>(
+            std::chrono::duration<double>(FLAGS_start_at_unix_s)));
+    while (!g_interrupted && std::chrono::system_clock::now() < start) {
+      std::this_thread::sleep_for(
+          std::min<std::chrono::system_clock::duration>(start - std::chrono::system_clock::now(),
+                                                        std::chrono::milliseconds(50)));
+    }
+  }
   const Status run_status = live->Run();
   finished = true;
   watcher.join();
@@ -271,6 +291,9 @@ int Main() {
                   "  playback: sensor stamp %lld ns at steady clock %lld ns, rate %.6g\n",
                   static_cast<long long>(st.sensor_start_ns),
                   static_cast<long long>(st.clock_start_ns), FLAGS_rate);
+    summary += line;
+    std::snprintf(line, sizeof(line), "  odometry initialized at sensor stamp %lld ns (its G)\n",
+                  static_cast<long long>(live->estimator().odometry().initialization().stamp_ns));
     summary += line;
     if (const net::ClockSync* sync = live->estimator().clock_sync()) {
       summary += net::FormatClockOffsets(*sync, st.sensor_end_ns, drone_names, "  ");

@@ -9,10 +9,15 @@
 #include <gflags/gflags.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "swarmlio/sim/output_writer.h"
 #include "swarmlio/sim/scenario.h"
@@ -22,6 +27,10 @@ DEFINE_string(output_dir, "", "output folder (created)");
 DEFINE_double(duration_s, 0.0, "override the scenario duration when > 0");
 DEFINE_int64(seed, -1, "override the scenario seed when >= 0");
 DEFINE_int32(threads, 0, "override the number of worker threads when > 0");
+DEFINE_string(clock_offsets_s,
+              "",
+              "override the drones' clock offsets: one value per drone in scenario order, "
+              "comma-separated [s] (e.g. 0,0.5,-0.5)");
 DEFINE_string(imperfections,
               "",
               "sensor imperfections preset over the scenario's (ideal or realistic; the "
@@ -56,6 +65,28 @@ int Main() {
   if (FLAGS_duration_s > 0) scenario.options.duration_s = FLAGS_duration_s;
   if (FLAGS_seed >= 0) scenario.options.seed = FLAGS_seed;
   if (FLAGS_threads > 0) scenario.options.num_threads = FLAGS_threads;
+  if (!FLAGS_clock_offsets_s.empty()) {
+    std::vector<double> offsets;
+    std::stringstream list(FLAGS_clock_offsets_s);
+    std::string item;
+    while (std::getline(list, item, ',')) {
+      char* end = nullptr;
+      const double v = std::strtod(item.c_str(), &end);
+      if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(v) ||
+          std::abs(v) > 1e6) {
+        std::fprintf(stderr, "error: --clock_offsets_s: '%s' is not a clock offset in seconds\n",
+                     item.c_str());
+        return 2;
+      }
+      offsets.push_back(v);
+    }
+    if (offsets.size() != scenario.drones.size()) {
+      std::fprintf(stderr, "error: --clock_offsets_s has %zu values, the scenario %zu drones\n",
+                   offsets.size(), scenario.drones.size());
+      return 2;
+    }
+    for (size_t i = 0; i < offsets.size(); ++i) scenario.drones[i].clock_offset_s = offsets[i];
+  }
   std::error_code ec;
   std::filesystem::create_directories(FLAGS_output_dir, ec);
   if (ec) {

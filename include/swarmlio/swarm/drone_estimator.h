@@ -95,6 +95,7 @@ struct DroneEstimatorCounters {
   int64_t passive_fused = 0;
   int64_t passive_repeated = 0;     // of passive_fused: sent again after the first message (lost)
   int64_t repeats_duplicate = 0;    // observations of this drone received twice: used once
+  int64_t extrinsics_stale = 0;     // teammates' T_Gj_Gi from before this session: ignored
   int64_t gravity_fused = 0;
   int64_t observations_rejected = 0;
   int64_t front_end_errors = 0;
@@ -121,7 +122,9 @@ class DroneEstimator : public lio::ScanStageHooks {
   /// Messages to broadcast, produced since the last call (one EgoStateMessage
   /// per scan, the extrinsics, the clock-synchronisation requests and
   /// responses). Send them now: the TimeSync stamps are the newest sensor
-  /// stamp given to this estimator (the driver's "now" on this drone's clock).
+  /// stamp given to this estimator (the driver's "now" on this drone's clock;
+  /// a deterministic function of the inputs, so an offline re-run of a
+  /// recorded live run reproduces it).
   void PopMessages(std::vector<net::SwarmMessage>* messages);
   /// Clock synchronisation with the teammates (null when synchronize_clocks is off).
   const net::ClockSync* clock_sync() const;
@@ -150,6 +153,11 @@ class DroneEstimator : public lio::ScanStageHooks {
   // Identification through teammates (docs/swarm.md): adds every k that a
   // first-hand teammate j identified and this drone has not.
   void AddTeammatesThroughTeammates(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P);
+
+  // Whether a teammate's message stamped `sender_stamp_ns` (its clock) was
+  // made after this drone's session began (by max_message_age_s): false
+  // before the odometry initialized or the sender's clock offset is known.
+  bool MadeInThisSession(int sender_id, int64_t sender_stamp_ns) const;
 
   // Keeps the observations of the state message `m` that the next message
   // repeats (SwarmOptions::repeat_observations), moved into G_i.
