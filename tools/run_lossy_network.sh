@@ -7,12 +7,20 @@
 #
 #   tools/run_lossy_network.sh                      # wall_degenerate corridor indoor_3uav
 #   tools/run_lossy_network.sh wall_degenerate      # only the named ones
+#   SEEDS="$(seq -s ' ' 1 16)" SCENARIO_SEEDS="2 102 202" OUT=results/ideal \
+#     tools/run_lossy_network.sh wall_degenerate    # held-out scenario seeds too
+#
+# SCENARIO_SEEDS (default: the file's seed) lists scenario seeds; one without a run in
+# OUT/<name>/seed<S>/ is simulated here (swarmlio_sim --seed S --imperfections
+# $IMPERFECTIONS, default ideal) and replayed lossless first.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
 OUT="${OUT:-$ROOT/results/scenarios}"
 REPLAY="$BUILD_DIR/tools/replay/swarmlio_replay"
+SIM="$BUILD_DIR/tools/sim/swarmlio_sim"
+IMPERFECTIONS="${IMPERFECTIONS:-ideal}"
 SEEDS="${SEEDS:-1 2 3}"
 LOSS="${LOSS:-0.2}"
 LATENCY_S="${LATENCY_S:-0.1}"
@@ -24,30 +32,41 @@ ape() {  # ape <metrics.csv> <drone>: the SE(3)-aligned APE RMSE [m]
                      NR > 1 && $1 == d { printf "%.4f", $c }' "$1"
 }
 
-echo "| scenario | drone | lossless | network seeds ${SEEDS// / \/ } | worst change |"
-echo "|---|---|---:|---|---:|"
+echo "| scenario | scenario seed | drone | lossless | network seeds ${SEEDS// / \/ } | worst change |"
+echo "|---|---:|---|---:|---|---:|"
 for name in "${scenarios[@]}"; do
   seed0=$(sed -nE '/^scenario:/,/^[a-z]/{s/.*seed: *([0-9]+).*/\1/p}' "$ROOT/configs/scenarios/$name.yaml" | head -n1)
-  dir="$OUT/$name/seed$seed0"
-  [[ -f "$dir/sim/swarm.yaml" && -f "$dir/swarm/metrics.csv" ]] ||
-    { echo "missing $dir/sim or $dir/swarm: run SEED_OFFSETS=0 tools/run_scenarios.sh $name first" >&2; exit 1; }
-  for seed in $SEEDS; do
-    cfg="$dir/lossy_seed$seed.yaml"
-    printf 'network:\n  seed: %s\n  default_link: {latency_mean_s: %s, jitter_std_s: 0.01, loss_probability: %s}\n' \
-      "$seed" "$LATENCY_S" "$LOSS" > "$cfg"
-    "$REPLAY" --manifest "$dir/sim/swarm.yaml" --network_config "$cfg" \
-      --output_dir "$dir/lossy_seed$seed" --save_maps=false > "$dir/lossy_seed$seed.log" 2>&1 ||
-      echo "replay failed: $dir/lossy_seed$seed.log" >&2
-  done
-  for drone in $(awk -F, 'NR > 1 { print $1 }' "$dir/swarm/metrics.csv"); do
-    base=$(ape "$dir/swarm/metrics.csv" "$drone")
-    values=() worst=0
+  for scenario_seed in ${SCENARIO_SEEDS:-$seed0}; do
+    dir="$OUT/$name/seed$scenario_seed"
+    if [[ "$scenario_seed" != "$seed0" && ! -f "$dir/swarm/metrics.csv" ]]; then
+      mkdir -p "$dir"
+      "$SIM" --scenario "$ROOT/configs/scenarios/$name.yaml" --seed "$scenario_seed" \
+          --imperfections "$IMPERFECTIONS" --output_dir "$dir/sim" > "$dir.sim.log" 2>&1 ||
+        { echo "simulation failed: $dir.sim.log" >&2; exit 1; }
+      "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/swarm" --save_maps=false \
+          > "$dir/swarm.log" 2>&1 || { echo "replay failed: $dir/swarm.log" >&2; exit 1; }
+    fi
+    [[ -f "$dir/sim/swarm.yaml" && -f "$dir/swarm/metrics.csv" ]] ||
+      { echo "missing $dir/sim or $dir/swarm: run SEED_OFFSETS=0 tools/run_scenarios.sh $name first" >&2; exit 1; }
     for seed in $SEEDS; do
-      v=$(ape "$dir/lossy_seed$seed/metrics.csv" "$drone")
-      values+=("${v:-n/a}")
-      worst=$(awk -v a="$v" -v b="$base" -v w="$worst" 'BEGIN { c = (a - b) / b * 100; print (c > w ? c : w) }')
+      cfg="$dir/lossy_seed$seed.yaml"
+      printf 'network:\n  seed: %s\n  default_link: {latency_mean_s: %s, jitter_std_s: 0.01, loss_probability: %s}\n' \
+        "$seed" "$LATENCY_S" "$LOSS" > "$cfg"
+      "$REPLAY" --manifest "$dir/sim/swarm.yaml" --network_config "$cfg" \
+        --output_dir "$dir/lossy_seed$seed" --save_maps=false > "$dir/lossy_seed$seed.log" 2>&1 ||
+        echo "replay failed: $dir/lossy_seed$seed.log" >&2
     done
-    joined=$(IFS=/; echo "${values[*]}")
-    printf '| %s | %s | %s | %s | %+.0f %% |\n' "$name" "$drone" "$base" "${joined//\// \/ }" "$worst"
+    for drone in $(awk -F, 'NR > 1 { print $1 }' "$dir/swarm/metrics.csv"); do
+      base=$(ape "$dir/swarm/metrics.csv" "$drone")
+      values=() worst=0
+      for seed in $SEEDS; do
+        v=$(ape "$dir/lossy_seed$seed/metrics.csv" "$drone")
+        values+=("${v:-n/a}")
+        worst=$(awk -v a="$v" -v b="$base" -v w="$worst" 'BEGIN { c = (a - b) / b * 100; print (c > w ? c : w) }')
+      done
+      joined=$(IFS=/; echo "${values[*]}")
+      printf '| %s | %s | %s | %s | %s | %+.0f %% |\n' "$name" "$scenario_seed" "$drone" "$base" \
+          "${joined//\// \/ }" "$worst"
+    done
   done
 done
