@@ -1,5 +1,6 @@
 #include "swarmlio/eval/trajectory.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -18,6 +19,23 @@ Eigen::Matrix3Xd Trajectory::Positions() const {
     positions.col(static_cast<Eigen::Index>(i)) = T_G_b[i].translation();
   }
   return positions;
+}
+
+bool Trajectory::PoseAt(double stamp_s, double max_gap_s, Eigen::Isometry3d* T) const {
+  if (size() < 2 || stamps_s.size() != size() || !(stamp_s >= stamps_s.front()) ||
+      !(stamp_s <= stamps_s.back())) {
+    return false;
+  }
+  const auto it = std::lower_bound(stamps_s.begin(), stamps_s.end(), stamp_s);
+  const size_t k = std::max<size_t>(1, static_cast<size_t>(it - stamps_s.begin()));
+  const double t0 = stamps_s[k - 1], t1 = stamps_s[k];
+  if (t1 - t0 > max_gap_s) return false;
+  const double a = t1 > t0 ? (stamp_s - t0) / (t1 - t0) : 0.0;
+  const Eigen::Quaterniond q0(T_G_b[k - 1].linear()), q1(T_G_b[k].linear());
+  *T = Eigen::Isometry3d::Identity();
+  T->linear() = q0.slerp(a, q1).toRotationMatrix();
+  T->translation() = (1.0 - a) * T_G_b[k - 1].translation() + a * T_G_b[k].translation();
+  return true;
 }
 
 Trajectory Trajectory::Select(const std::vector<size_t>& ids) const {

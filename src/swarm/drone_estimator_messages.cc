@@ -148,59 +148,48 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   // j's observations of this drone: each one once, whether it comes in the
   // message of its scan or repeated in the next (stamps on j's clock; a
   // repeat's age travels in 0.1 ms steps).
-  const auto take = [&info](int64_t remote_stamp_ns) {
+  const auto queue = [&](int64_t age_ns, const Eigen::Vector3d& p_bi, const Eigen::Matrix3d& cov,
+                         bool repeated) {
     constexpr int64_t kTolerance = net::kPastObservationAgeStepNs / 2 + 1;
+    const int64_t remote_stamp_ns = received_state->stamp_ns - age_ns;
     for (int64_t t : info.taken_observation_stamps) {
-      if (std::abs(t - remote_stamp_ns) <= kTolerance) return false;
+      if (std::abs(t - remote_stamp_ns) <= kTolerance) {
+        ++counters_.repeats_duplicate;
+        return;
+      }
     }
     info.taken_observation_stamps.push_back(remote_stamp_ns);
     constexpr size_t kKeep = 16;
     while (info.taken_observation_stamps.size() > kKeep) info.taken_observation_stamps.pop_front();
-    return true;
+    PendingPassive p;
+    p.from = m->sender_id;
+    p.repeated = repeated;
+    p.stamp_ns = m->stamp_ns - age_ns;
+    p.p_bi_in_bj = p_bi;
+    p.cov = cov;
+    p.sender = *m;
+    p.sender.observations.clear();
+    p.sender.past_observations.clear();
+    if (repeated) {
+      // A repeat travels in G_j: its sender is "at the origin of G_j", the
+      // sender's pose uncertainty already in the observation's covariance.
+      p.sender.q_Gj_bj = Eigen::Quaterniond::Identity();
+      p.sender.p_bj_in_Gj.setZero();
+      p.sender.cov_theta_Gj_bj.setZero();
+      p.sender.cov_p_bj_in_Gj.setZero();
+    }
+    impl_->passive.push_back(std::move(p));
   };
   for (const net::TeammateObservation& o : m->observations) {
-    if (o.observed_id != self_id_ || !o.p_bk_in_bj.allFinite() || !o.cov_p_bk_in_bj.allFinite()) {
-      continue;
+    if (o.observed_id == self_id_ && o.p_bk_in_bj.allFinite() && o.cov_p_bk_in_bj.allFinite()) {
+      queue(0, o.p_bk_in_bj, o.cov_p_bk_in_bj, false);
     }
-    if (!take(received_state->stamp_ns)) {
-      ++counters_.repeats_duplicate;
-      continue;
-    }
-    PendingPassive p;
-    p.from = m->sender_id;
-    p.stamp_ns = m->stamp_ns;
-    p.p_bi_in_bj = o.p_bk_in_bj;
-    p.cov = o.cov_p_bk_in_bj;
-    p.sender = *m;
-    p.sender.observations.clear();
-    p.sender.past_observations.clear();
-    impl_->passive.push_back(std::move(p));
   }
   for (const net::PastObservation& o : m->past_observations) {
-    if (o.observed_id != self_id_ || o.age_ns <= 0 || !o.p_bk_in_Gj.allFinite() ||
-        !o.cov_p_bk_in_Gj.allFinite()) {
-      continue;
+    if (o.observed_id == self_id_ && o.age_ns > 0 && o.p_bk_in_Gj.allFinite() &&
+        o.cov_p_bk_in_Gj.allFinite()) {
+      queue(o.age_ns, o.p_bk_in_Gj, o.cov_p_bk_in_Gj, true);
     }
-    if (!take(received_state->stamp_ns - o.age_ns)) {
-      ++counters_.repeats_duplicate;
-      continue;
-    }
-    // The observation already in G_j: a sender "at the origin of G_j" whose
-    // pose uncertainty is in the observation's covariance.
-    PendingPassive p;
-    p.from = m->sender_id;
-    p.repeated = true;
-    p.stamp_ns = m->stamp_ns - o.age_ns;
-    p.p_bi_in_bj = o.p_bk_in_Gj;
-    p.cov = o.cov_p_bk_in_Gj;
-    p.sender = *m;
-    p.sender.observations.clear();
-    p.sender.past_observations.clear();
-    p.sender.q_Gj_bj = Eigen::Quaterniond::Identity();
-    p.sender.p_bj_in_Gj.setZero();
-    p.sender.cov_theta_Gj_bj.setZero();
-    p.sender.cov_p_bj_in_Gj.setZero();
-    impl_->passive.push_back(std::move(p));
   }
   return Status::Ok();
 }

@@ -228,5 +228,25 @@ TEST(KittiReader, BadInput) {
   EXPECT_FALSE(TrajectoryFormatFromString("csv", &format));
 }
 
+TEST(Trajectory, PoseAtInterpolatesBetweenNeighboursWithinTheGap) {
+  Trajectory t;
+  t.stamps_s = {1.0, 2.0, 4.0};
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(0.2 * k, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T.translation() = Eigen::Vector3d(k, 2.0 * k, 0.0);
+    t.T_G_b.push_back(T);
+  }
+  Eigen::Isometry3d T;
+  ASSERT_TRUE(t.PoseAt(1.25, 1.5, &T));
+  EXPECT_NEAR((T.translation() - Eigen::Vector3d(0.25, 0.5, 0.0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(Eigen::AngleAxisd(T.linear()).angle(), 0.05, 1e-12);
+  ASSERT_TRUE(t.PoseAt(4.0, 2.5, &T));  // the last stamp itself
+  EXPECT_NEAR((T.translation() - Eigen::Vector3d(2.0, 4.0, 0.0)).norm(), 0.0, 1e-12);
+  EXPECT_FALSE(t.PoseAt(3.0, 1.5, &T));  // the neighbours are 2 s apart
+  EXPECT_FALSE(t.PoseAt(0.5, 10.0, &T));
+  EXPECT_FALSE(t.PoseAt(4.5, 10.0, &T));
+}
+
 }  // namespace
 }  // namespace swarmlio::eval

@@ -97,6 +97,30 @@ class CollectingSink : public LiveSink {
   int64_t last_imu_ns = 0;
 };
 
+/// One drone alone (a simulated network of three, the others silent) on a
+/// racing clock. Its collaborators outlive it: `drone` is destroyed first.
+struct RacingDrone {
+  std::unique_ptr<net::SimulatedNetwork> network;
+  RacingClock clock;
+  CollectingSink sink;
+  std::unique_ptr<LiveDrone> drone;
+
+  /// Creates and runs the drone; the first error of either step.
+  Status Run(const replay::DroneInput& input, const LiveOptions& options) {
+    Status s = net::SimulatedNetwork::Create(net::NetworkOptions(), {0, 1, 2}, &network);
+    if (!s.ok()) return s;
+    LiveSetup setup;
+    setup.drone = input;
+    setup.drone_id = 0;
+    setup.transport = network->Endpoint(0);
+    setup.clock = &clock;
+    setup.sink = &sink;
+    s = LiveDrone::Create(setup, options, &drone);
+    if (!s.ok()) return s;
+    return drone->Run();
+  }
+};
+
 int FreeUdpPort() {
   const int fd = socket(AF_INET, SOCK_DGRAM, 0);
   if (fd < 0) return 0;
@@ -265,27 +289,16 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
 }
 
 TEST_F(LiveDropTest, FallingBehindDropsWholeScansNeverImu) {
-  std::unique_ptr<net::SimulatedNetwork> network;
-  ASSERT_TRUE(net::SimulatedNetwork::Create(net::NetworkOptions(), {0, 1, 2}, &network).ok());
-  RacingClock clock;
-  CollectingSink sink;
-  LiveSetup setup;
-  setup.drone = manifest_->drones[0];
-  setup.drone_id = 0;
-  setup.transport = network->Endpoint(0);
-  setup.clock = &clock;
-  setup.sink = &sink;
   LiveOptions options;
   options.max_scan_backlog_s = 0.05;
   options.max_queued_scans = 2;
   options.input_queue_records = 64;
-  std::unique_ptr<LiveDrone> drone;
-  Status s = LiveDrone::Create(setup, options, &drone);
+  RacingDrone racing;
+  const Status s = racing.Run(manifest_->drones[0], options);
   ASSERT_TRUE(s.ok()) << s.message();
-  s = drone->Run();
-  ASSERT_TRUE(s.ok()) << s.message();
-  const LiveStats& st = drone->stats();
-  const lio::OdometryCounters& c = drone->estimator().odometry().counters();
+  const LiveStats& st = racing.drone->stats();
+  const lio::OdometryCounters& c = racing.drone->estimator().odometry().counters();
+  const CollectingSink& sink = racing.sink;
   const int64_t dropped = st.scans_dropped_queue + st.scans_dropped_backlog;
   std::printf("racing clock: %lld scans played, %lld dropped (%lld queue, %lld backlog), %lld "
               "processed; %lld IMU samples\n",
@@ -305,23 +318,11 @@ TEST_F(LiveDropTest, FallingBehindDropsWholeScansNeverImu) {
 // offset: the first played record is the first one at or after it.
 TEST_F(LiveDropTest, StartOffsetSkipsTheLogsFirstSeconds) {
   const auto first_played = [&](double start_offset_s, Status* status) {
-    std::unique_ptr<net::SimulatedNetwork> network;
-    EXPECT_TRUE(net::SimulatedNetwork::Create(net::NetworkOptions(), {0, 1, 2}, &network).ok());
-    RacingClock clock;
-    CollectingSink sink;
-    LiveSetup setup;
-    setup.drone = manifest_->drones[0];
-    setup.drone_id = 0;
-    setup.transport = network->Endpoint(0);
-    setup.clock = &clock;
-    setup.sink = &sink;
     LiveOptions options;
     options.start_offset_s = start_offset_s;
-    std::unique_ptr<LiveDrone> drone;
-    *status = LiveDrone::Create(setup, options, &drone);
-    if (!status->ok()) return int64_t{0};
-    *status = drone->Run();
-    return drone->stats().sensor_start_ns;
+    RacingDrone racing;
+    *status = racing.Run(manifest_->drones[0], options);
+    return racing.drone != nullptr ? racing.drone->stats().sensor_start_ns : int64_t{0};
   };
   Status s;
   const int64_t from_start = first_played(0.0, &s);

@@ -6,33 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace swarmlio::tools {
 namespace {
-
-Eigen::Isometry3d T_W_G(const replay::DroneInput& d) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = d.R_W_G;
-  T.translation() = d.p_G_in_W_m;
-  return T;
-}
-
-// The body pose at `stamp_s` (position interpolated, attitude slerped).
-Status PoseAt(const eval::Trajectory& t, double stamp_s, Eigen::Isometry3d* T) {
-  if (t.size() < 2 || stamp_s < t.stamps_s.front() || stamp_s > t.stamps_s.back()) {
-    return Status::OutOfRange("stamp " + std::to_string(stamp_s) + " s is outside the ground truth");
-  }
-  const auto it = std::lower_bound(t.stamps_s.begin(), t.stamps_s.end(), stamp_s);
-  const size_t k = std::max<size_t>(1, static_cast<size_t>(it - t.stamps_s.begin()));
-  const double t0 = t.stamps_s[k - 1], t1 = t.stamps_s[k];
-  const double a = t1 > t0 ? (stamp_s - t0) / (t1 - t0) : 0.0;
-  const Eigen::Quaterniond q0(t.T_G_b[k - 1].linear()), q1(t.T_G_b[k].linear());
-  *T = Eigen::Isometry3d::Identity();
-  T->linear() = q0.slerp(a, q1).toRotationMatrix();
-  T->translation() = (1.0 - a) * t.T_G_b[k - 1].translation() + a * t.T_G_b[k].translation();
-  return Status::Ok();
-}
 
 int IndexOf(const replay::SwarmManifest& manifest, const std::string& name) {
   for (size_t i = 0; i < manifest.drones.size(); ++i) {
@@ -53,7 +31,7 @@ Status EvaluateExtrinsicErrors(const std::string& csv_path,
   if (i < 0) return Status::NotFound("observer '" + observer + "' is not a drone of the manifest");
   // Each drone's global frame in the simulation world.
   std::vector<Eigen::Isometry3d> T_W_Gs;
-  for (const replay::DroneInput& d : manifest.drones) T_W_Gs.push_back(T_W_G(d));
+  for (const replay::DroneInput& d : manifest.drones) T_W_Gs.push_back(d.T_W_G());
   for (const auto& [name, stamp_s] : origins) {
     const int k = IndexOf(manifest, name);
     if (k < 0) return Status::NotFound("origin for '" + name + "': not a drone of the manifest");
@@ -65,8 +43,10 @@ Status EvaluateExtrinsicErrors(const std::string& csv_path,
     SWARMLIO_RETURN_IF_ERROR(
         eval::ReadTumTrajectory(d.ground_truth_path, eval::TrajectoryReadOptions(), &truth));
     Eigen::Isometry3d T_G_b;
-    const Status s = PoseAt(truth, stamp_s, &T_G_b);
-    if (!s.ok()) return s.WithContext(name + " origin");
+    if (!truth.PoseAt(stamp_s, std::numeric_limits<double>::infinity(), &T_G_b)) {
+      return Status::OutOfRange(name + " origin: stamp " + std::to_string(stamp_s) +
+                                " s is outside the ground truth");
+    }
     T_W_Gs[static_cast<size_t>(k)] = T_W_Gs[static_cast<size_t>(k)] * T_G_b;
   }
   std::ifstream in(csv_path);

@@ -17,24 +17,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Eigen::Isometry3d T_W_G(const replay::DroneInput& d) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = d.R_W_G;
-  T.translation() = d.p_G_in_W_m;
-  return T;
-}
-
-// Position of a trajectory at t by linear interpolation; false outside it.
-bool PositionAt(const eval::Trajectory& t, double stamp_s, Eigen::Vector3d* p) {
-  if (t.size() < 2 || stamp_s < t.stamps_s.front() || stamp_s > t.stamps_s.back()) return false;
-  const auto it = std::lower_bound(t.stamps_s.begin(), t.stamps_s.end(), stamp_s);
-  const size_t k = std::max<size_t>(1, static_cast<size_t>(it - t.stamps_s.begin()));
-  const double t0 = t.stamps_s[k - 1], t1 = t.stamps_s[k];
-  if (t1 - t0 > 0.5) return false;
-  const double a = t1 > t0 ? (stamp_s - t0) / (t1 - t0) : 0.0;
-  *p = (1.0 - a) * t.T_G_b[k - 1].translation() + a * t.T_G_b[k].translation();
-  return true;
-}
+// A teammate's true position is interpolated between ground-truth poses at
+// most this far apart [s].
+constexpr double kMaxTruthGapS = 0.5;
 
 // Start of the excitation flight from the ground truth: the first time the
 // horizontal speed exceeds 0.05 m/s (the plans hover, take off vertically,
@@ -117,7 +102,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
           teammate_tum[r.drone_id].T_G_b.push_back(T);
         }
         // Errors against the truth (simulated runs: the manifest's G frames).
-        const Eigen::Isometry3d T_true = T_W_G(d.input()).inverse() * T_W_G(run.drone(r.drone_id).input());
+        const Eigen::Isometry3d T_true = d.input().T_W_G().inverse() * run.drone(r.drone_id).input().T_W_G();
         const double e_m = (p - T_true.translation()).norm();
         const double e_deg = RotationDeg(T_true.linear().transpose() * r.T_Gi_Gj.R_Gi_Gj());
         m.extrinsic_end_m = e_m;
@@ -127,10 +112,10 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
         // j's ground truth is stamped in j's clock: the same true instant.
         const replay::TrueClock& clock_j = run.drone(r.drone_id).input().true_clock;
         const double t_j = StampSeconds(clock_j.ToDrone(d.input().true_clock.ToTrue(s.stamp_ns)));
-        Eigen::Vector3d p_true_in_Gj;
+        Eigen::Isometry3d T_true_Gj_bj;
         if (r.have_pose && has_truth[r.drone_id] &&
-            PositionAt(truth[r.drone_id], t_j, &p_true_in_Gj)) {
-          const double err = (r.p_bj_in_Gi - T_true * p_true_in_Gj).norm();
+            truth[r.drone_id].PoseAt(t_j, kMaxTruthGapS, &T_true_Gj_bj)) {
+          const double err = (r.p_bj_in_Gi - T_true * T_true_Gj_bj.translation()).norm();
           m.relative_rmse_m += err * err;
           ++m.relative_samples;
         }
@@ -161,7 +146,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
           m.identified = true;
           m.identification_s = StampSeconds(e.stamp_ns) - t0;
           const Eigen::Isometry3d T_true =
-              T_W_G(d.input()).inverse() * T_W_G(run.drone(j).input());
+              d.input().T_W_G().inverse() * run.drone(j).input().T_W_G();
           m.initial_error_m = (e.initial_T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm();
           m.initial_error_deg =
               RotationDeg(T_true.linear().transpose() * e.initial_T_Gi_Gj.R_Gi_Gj());

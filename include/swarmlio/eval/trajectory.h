@@ -38,6 +38,11 @@ struct Trajectory {
 
   /// The trajectory restricted to the poses ids (in that order).
   Trajectory Select(const std::vector<size_t>& ids) const;
+
+  /// The pose at `stamp_s`, between the two stamped poses around it
+  /// (position linear, rotation slerp). False without stamps, outside the
+  /// stamps, or when those two poses are more than `max_gap_s` apart.
+  bool PoseAt(double stamp_s, double max_gap_s, Eigen::Isometry3d* T_G_b) const;
 };
 
 /// A stamped trajectory from poses of b in G (e.g. estimator output or bag

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <string>
 #include <utility>
@@ -84,6 +85,15 @@ struct DroneInput {
   /// for drawing all drones in one top view (identity when unknown).
   Eigen::Matrix3d R_W_G = Eigen::Matrix3d::Identity();
   Eigen::Vector3d p_G_in_W_m = Eigen::Vector3d::Zero();
+
+  /// The same as one transform (a simulated run's true T_Gi_Gj is
+  /// T_W_G() of i, inverted, times T_W_G() of j).
+  Eigen::Isometry3d T_W_G() const {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = R_W_G;
+    T.translation() = p_G_in_W_m;
+    return T;
+  }
 };
 
 struct SwarmManifest {
