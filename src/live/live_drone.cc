@@ -333,7 +333,11 @@ void LiveDrone::Impl::EstimatorLoop() {
 }
 
 void LiveDrone::Impl::Send(const Outgoing& out) {
-  const Status sent = channel->Send(out.stamp_ns, net::kBroadcastId, out.message);
+  // Stamped with the time it really leaves (an EgoState's send delay is the
+  // clock synchronisation's t1/t3); a teammate echoes it back, so a re-run of
+  // the recording reproduces the exchanges without this drone's clock.
+  const int64_t now_ns = mapping.ToSensorNs(setup.clock->NowNs());
+  const Status sent = channel->Send(now_ns, net::kBroadcastId, out.message);
   if (sent.ok()) {
     ++stats.messages_sent;
   } else {

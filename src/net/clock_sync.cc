@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "swarmlio/net/swarm_limits.h"
+#include "swarmlio/net/wire_format.h"
 
 namespace swarmlio::net {
 namespace {
@@ -25,6 +26,8 @@ constexpr int kReweightIterations = 4;
 constexpr double kHuberK = 2.0;
 // Median absolute deviation to standard deviation (normal distribution).
 constexpr double kMadToSigma = 1.4826;
+// State echo: own state stamps remembered for the echoes (10 s at 10 Hz).
+constexpr size_t kOwnStates = 100;
 
 int64_t SecondsToNs(double s) { return std::llround(s * kNsPerS); }
 
@@ -42,8 +45,8 @@ std::string ClockSyncOptions::Validate() const {
   return error;
 }
 
-Status ReduceTimeSyncExchange(
-    int64_t t1_ns, int64_t t2_ns, int64_t t3_ns, int64_t t4_ns, TimeSyncSample* sample) {
+Status ReduceTimeSyncExchange(int64_t t1_ns, int64_t t2_ns, int64_t t3_ns, int64_t t4_ns,
+                              TimeSyncSample* sample, int64_t stamp_step_ns) {
   int64_t round_trip = 0, turnaround = 0, forward = 0, backward = 0, sum = 0, delay = 0;
   if (!Sub(t4_ns, t1_ns, &round_trip) || !Sub(t3_ns, t2_ns, &turnaround) ||
       !Sub(t2_ns, t1_ns, &forward) || !Sub(t3_ns, t4_ns, &backward) ||
@@ -60,7 +63,7 @@ Status ReduceTimeSyncExchange(
   }
   // Clocks that run at slightly different rates can make a near-zero network
   // delay look negative by (drift) x (turnaround); more than that is bogus.
-  const int64_t tolerance = 1000 + turnaround / 5000;
+  const int64_t tolerance = 1000 + turnaround / 5000 + 2 * std::max<int64_t>(0, stamp_step_ns);
   if (delay < -tolerance) {
     return Status::InvalidArgument("time sync: round trip " + std::to_string(delay) +
                                    " ns is negative (turnaround longer than the whole exchange)");
@@ -313,7 +316,100 @@ void ClockSync::ExpireRequests(int64_t now_ns, Teammate* teammate) const {
   }
 }
 
+void ClockSync::NoteOwnState(int64_t stamp_ns) {
+  if (!echo_mode()) return;
+  own_stamps_.push_back(stamp_ns);
+  if (own_stamps_.size() > kOwnStates) own_stamps_.pop_front();
+}
+
+void ClockSync::NoteTeammateState(const EgoStateMessage& state, int64_t arrival_ns) {
+  auto it = teammates_.find(state.sender_id);
+  if (it == teammates_.end() || state.send_delay_ns < 0) return;
+  Teammate& teammate = it->second;
+  if (echo_mode()) {
+    teammate.state_to_echo = true;
+    teammate.state_stamp_ns = state.stamp_ns;
+    teammate.state_send_delay_ns = state.send_delay_ns;
+    teammate.state_arrival_ns = arrival_ns;
+  }
+  int64_t t3 = 0;
+  if (!Add(state.stamp_ns, state.send_delay_ns, &t3)) return;
+  for (const StateEcho& echo : state.echoes) {
+    if (echo.teammate_id != self_id_) continue;
+    // The newest of our states with that reference (unique over 65 s).
+    auto own = std::find_if(own_stamps_.rbegin(), own_stamps_.rend(), [&](int64_t stamp) {
+      return StateEchoRef(stamp) == echo.stamp_ref;
+    });
+    int64_t t1 = 0;
+    if (own == own_stamps_.rend() || !Add(*own, echo.send_delay_ns, &t1)) {
+      ++teammate.stats.echoes_unmatched;
+      continue;
+    }
+    if (AddExchange(t1, echo.arrival_ns, t3, arrival_ns, kSyncDelayStepNs, &teammate)) {
+      ++teammate.stats.echoes_matched;
+    }
+  }
+}
+
+void ClockSync::EchoesFor(int64_t now_ns, std::vector<StateEcho>* echoes) {
+  if (!echo_mode()) return;
+  const int64_t max_age_ns = SecondsToNs(options_.max_echo_age_s);
+  const int64_t period_ns = SecondsToNs(options_.echo_period_s);
+  std::vector<std::pair<uint64_t, int>> due;  // (echo order, id): least recently echoed first
+  for (const auto& [id, teammate] : teammates_) {
+    if (!teammate.state_to_echo) continue;
+    const int64_t age_ns = now_ns - teammate.state_arrival_ns;
+    if (age_ns < 0 || age_ns > max_age_ns) continue;
+    if (teammate.last_echo_ns != std::numeric_limits<int64_t>::min() &&
+        now_ns - teammate.last_echo_ns < period_ns) {
+      continue;
+    }
+    due.emplace_back(teammate.echo_order, id);
+  }
+  std::sort(due.begin(), due.end());
+  if (due.size() > static_cast<size_t>(options_.max_echoes_per_state)) {
+    due.resize(static_cast<size_t>(options_.max_echoes_per_state));
+  }
+  for (const auto& [last, id] : due) {
+    (void)last;
+    Teammate& teammate = teammates_.at(id);
+    StateEcho echo;
+    echo.teammate_id = id;
+    echo.stamp_ref = StateEchoRef(teammate.state_stamp_ns);
+    echo.send_delay_ns = teammate.state_send_delay_ns;
+    echo.arrival_ns = teammate.state_arrival_ns;
+    echoes->push_back(echo);
+    teammate.state_to_echo = false;
+    teammate.last_echo_ns = now_ns;
+    teammate.echo_order = ++echoes_made_;
+    ++teammate.stats.echoes_sent;
+  }
+}
+
+bool ClockSync::AddExchange(int64_t t1_ns, int64_t t2_ns, int64_t t3_ns, int64_t t4_ns,
+                            int64_t stamp_step_ns, Teammate* teammate) {
+  TimeSyncSample sample;
+  if (!ReduceTimeSyncExchange(t1_ns, t2_ns, t3_ns, t4_ns, &sample, stamp_step_ns).ok()) {
+    ++teammate->stats.exchanges_invalid;
+    return false;
+  }
+  switch (teammate->estimator.AddSample(sample)) {
+    case ClockOffsetEstimator::Verdict::kAdded:
+      break;
+    case ClockOffsetEstimator::Verdict::kOutlier:
+      ++teammate->stats.outliers;
+      break;
+    case ClockOffsetEstimator::Verdict::kStepReset:
+      ++teammate->stats.outliers;
+      ++teammate->stats.resets;
+      teammate->burst_remaining = options_.burst_requests;
+      break;
+  }
+  return true;
+}
+
 void ClockSync::DueRequests(int64_t now_ns, std::vector<TimeSyncMessage>* requests) {
+  if (echo_mode()) return;
   for (auto& [id, teammate] : teammates_) {
     ExpireRequests(now_ns, &teammate);
     if (teammate.next_request_ns > now_ns) continue;
@@ -347,6 +443,7 @@ void ClockSync::DueRequests(int64_t now_ns, std::vector<TimeSyncMessage>* reques
 
 int64_t ClockSync::NextRequestNs() const {
   int64_t next = std::numeric_limits<int64_t>::max();
+  if (echo_mode()) return next;
   for (const auto& [id, teammate] : teammates_) {
     (void)id;
     next = std::min(next, teammate.next_request_ns);
@@ -379,24 +476,8 @@ bool ClockSync::HandleMessage(const TimeSyncMessage& message,
     return false;
   }
   teammate.outstanding.erase(match);
-  TimeSyncSample sample;
-  if (!ReduceTimeSyncExchange(message.t1_ns, message.t2_ns, message.t3_ns, arrival_ns, &sample)
-           .ok()) {
-    ++teammate.stats.exchanges_invalid;
-    return false;
-  }
-  ++teammate.stats.responses_matched;
-  switch (teammate.estimator.AddSample(sample)) {
-    case ClockOffsetEstimator::Verdict::kAdded:
-      break;
-    case ClockOffsetEstimator::Verdict::kOutlier:
-      ++teammate.stats.outliers;
-      break;
-    case ClockOffsetEstimator::Verdict::kStepReset:
-      ++teammate.stats.outliers;
-      ++teammate.stats.resets;
-      teammate.burst_remaining = options_.burst_requests;
-      break;
+  if (AddExchange(message.t1_ns, message.t2_ns, message.t3_ns, arrival_ns, 0, &teammate)) {
+    ++teammate.stats.responses_matched;
   }
   return false;
 }
@@ -429,10 +510,12 @@ std::string FormatClockOffsets(const ClockSync& sync, int64_t now_ns,
         static_cast<size_t>(j) < names.size() ? names[static_cast<size_t>(j)] : "id" + std::to_string(j);
     char line[256];
     std::snprintf(line, sizeof(line),
-                  "clock of %s: offset %+.3f ms (std %.3f ms, drift %+.1f ppm), %d exchanges, "
-                  "%llu requests, %llu timed out\n",
+                  "clock of %s: offset %+.3f ms (std %.3f ms, drift %+.1f ppm), %d exchanges "
+                  "(%llu of its echoes, %llu responses), %llu requests, %llu timed out\n",
                   name.c_str(), 1e-6 * static_cast<double>(e.offset_ns), 1e-6 * e.std_ns,
-                  e.drift_ppm, e.num_samples, static_cast<unsigned long long>(st.requests_sent),
+                  e.drift_ppm, e.num_samples, static_cast<unsigned long long>(st.echoes_matched),
+                  static_cast<unsigned long long>(st.responses_matched),
+                  static_cast<unsigned long long>(st.requests_sent),
                   static_cast<unsigned long long>(st.requests_timed_out));
     text += indent + line;
   }

@@ -57,6 +57,17 @@ void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
   WriteCovariance<3>(m.cov_theta_Gj_bj, w);
   WriteCovariance<3>(m.cov_p_bj_in_Gj, w);
   WriteCovariance<3>(m.cov_v_bj_in_Gj, w);
+  w->U16(static_cast<uint16_t>(m.send_delay_ns < 0 ? kSendDelayUnknownCode
+                                                   : SyncDelayCode(m.send_delay_ns)));
+  w->U8(static_cast<uint8_t>(m.echoes.size()));
+  for (const StateEcho& e : m.echoes) {
+    int64_t hold_ns = 0;
+    StateEchoHoldNs(m.stamp_ns, m.send_delay_ns, e.arrival_ns, &hold_ns);  // checked by Check()
+    w->U8(static_cast<uint8_t>(e.teammate_id));
+    w->U16(e.stamp_ref);
+    w->U16(static_cast<uint16_t>(SyncDelayCode(e.send_delay_ns)));
+    w->U16(static_cast<uint16_t>(SyncDelayCode(hold_ns)));
+  }
   for (const TeammateObservation& o : m.observations) {
     w->U8(static_cast<uint8_t>(o.observed_id));
     WriteScaledVectorI16(o.p_bk_in_bj, kObservationPositionStepM, w);
@@ -90,12 +101,8 @@ Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* out) {
     return Status::DataLoss("observation count " + std::to_string(count) + " exceeds the maximum " +
                             std::to_string(EgoStateMessage::kMaxObservations));
   }
-  const size_t after_fixed = kEgoStateFixedBytes - r->position();
-  // The observations end the payload, or the past-observation section follows.
-  if (after_fixed > r->remaining() ||
-      static_cast<size_t>(count) * kObservationBytes > r->remaining() - after_fixed) {
-    return Status::DataLoss("observation count " + std::to_string(count) + " needs " +
-                            std::to_string(kEgoStateFixedBytes + count * kObservationBytes) +
+  if (kEgoStateFixedBytes - r->position() > r->remaining()) {
+    return Status::DataLoss("the fixed part needs " + std::to_string(kEgoStateFixedBytes) +
                             " payload bytes but the payload has " +
                             std::to_string(r->position() + r->remaining()));
   }
@@ -106,6 +113,51 @@ Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* out) {
   SWARMLIO_RETURN_IF_ERROR(ReadCovariance<3>("cov_theta_Gj_bj", r, &m.cov_theta_Gj_bj));
   SWARMLIO_RETURN_IF_ERROR(ReadCovariance<3>("cov_p_bj_in_Gj", r, &m.cov_p_bj_in_Gj));
   SWARMLIO_RETURN_IF_ERROR(ReadCovariance<3>("cov_v_bj_in_Gj", r, &m.cov_v_bj_in_Gj));
+  uint16_t delay_code = 0;
+  SWARMLIO_RETURN_IF_ERROR(r->U16("send_delay", &delay_code));
+  m.send_delay_ns = delay_code == kSendDelayUnknownCode ? -1 : int64_t{delay_code} * kSyncDelayStepNs;
+  uint8_t echo_count = 0;
+  SWARMLIO_RETURN_IF_ERROR(r->U8("echo count", &echo_count));
+  if (echo_count > EgoStateMessage::kMaxEchoes) {
+    return Status::DataLoss("echo count " + std::to_string(echo_count) + " exceeds the maximum " +
+                            std::to_string(EgoStateMessage::kMaxEchoes));
+  }
+  if (echo_count > 0 && m.send_delay_ns < 0) {
+    return Status::DataLoss("echo count " + std::to_string(echo_count) +
+                            " with an unknown send delay");
+  }
+  // The observations end the payload, or the past-observation section follows.
+  const size_t lists = size_t{echo_count} * kStateEchoBytes +
+                       static_cast<size_t>(count) * kObservationBytes;
+  if (lists > r->remaining()) {
+    return Status::DataLoss("observation count " + std::to_string(count) + " needs " +
+                            std::to_string(r->position() + lists) + " payload bytes (with " +
+                            std::to_string(echo_count) + " echoes) but the payload has " +
+                            std::to_string(r->position() + r->remaining()));
+  }
+  m.echoes.resize(echo_count);
+  for (int i = 0; i < echo_count; ++i) {
+    StateEcho& e = m.echoes[static_cast<size_t>(i)];
+    uint8_t id = 0;
+    uint16_t ref = 0, delay = 0, hold = 0;
+    SWARMLIO_RETURN_IF_ERROR(r->U8("echo teammate_id", &id));
+    SWARMLIO_RETURN_IF_ERROR(r->U16("echo stamp_ref", &ref));
+    SWARMLIO_RETURN_IF_ERROR(r->U16("echo send_delay", &delay));
+    SWARMLIO_RETURN_IF_ERROR(r->U16("echo hold", &hold));
+    if (delay > kSendDelayMaxCode) {
+      return Status::DataLoss("echoes[" + std::to_string(i) + "]: send delay code " +
+                              std::to_string(delay) + " is not a known delay");
+    }
+    e.teammate_id = id;
+    e.stamp_ref = ref;
+    e.send_delay_ns = int64_t{delay} * kSyncDelayStepNs;
+    // stamp + send delay - hold; the stamp is any int64, so guard the sum.
+    int64_t sent_ns = 0;
+    if (__builtin_add_overflow(m.stamp_ns, m.send_delay_ns, &sent_ns) ||
+        __builtin_sub_overflow(sent_ns, int64_t{hold} * kSyncDelayStepNs, &e.arrival_ns)) {
+      return Status::DataLoss("echoes[" + std::to_string(i) + "]: arrival overflows int64");
+    }
+  }
   m.observations.resize(static_cast<size_t>(count));
   for (int i = 0; i < count; ++i) {
     const Status s = DecodeObservation(r, &m.observations[static_cast<size_t>(i)]);

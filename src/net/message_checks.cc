@@ -191,6 +191,42 @@ Status Check(const EgoStateMessage& m) {
     c.ObservationPosition("p_bk_in_Gj - p_bj_in_Gj", o.p_bk_in_Gj - p_bj_sent);
     c.Covariance<3>("cov_p_bk_in_Gj", o.cov_p_bk_in_Gj);
   }
+  c.SetContext("");
+  const auto delay_range = [](int max_code) {
+    return "[0, " + std::to_string(max_code * kSyncDelayStepNs + kSyncDelayStepNs / 2) + ") ns";
+  };
+  if (m.send_delay_ns != -1 &&
+      (m.send_delay_ns < 0 || SyncDelayCode(m.send_delay_ns) > kSendDelayMaxCode)) {
+    c.Fail("send_delay_ns", -1,
+           "= " + std::to_string(m.send_delay_ns) + " is neither -1 (not known) nor in " +
+               delay_range(kSendDelayMaxCode));
+  }
+  if (m.echoes.size() > static_cast<size_t>(EgoStateMessage::kMaxEchoes)) {
+    c.Fail("echoes", -1,
+           "has " + std::to_string(m.echoes.size()) + " entries, more than the maximum " +
+               std::to_string(EgoStateMessage::kMaxEchoes));
+  }
+  if (!m.echoes.empty() && m.send_delay_ns < 0 && c.ok()) {
+    c.Fail("echoes", -1, "need a known send_delay_ns (the hold is relative to the send time)");
+  }
+  uint64_t seen_echo = 0;
+  for (size_t i = 0; i < m.echoes.size() && c.ok(); ++i) {
+    c.SetContext("echoes[" + std::to_string(i) + "].");
+    const StateEcho& e = m.echoes[i];
+    c.TeammateId("teammate_id", e.teammate_id, m.sender_id, &seen_echo);
+    if (e.send_delay_ns < 0 || SyncDelayCode(e.send_delay_ns) > kSendDelayMaxCode) {
+      c.Fail("send_delay_ns", -1,
+             "= " + std::to_string(e.send_delay_ns) + " is outside " +
+                 delay_range(kSendDelayMaxCode));
+    }
+    int64_t hold_ns = 0;
+    if (!StateEchoHoldNs(m.stamp_ns, m.send_delay_ns, e.arrival_ns, &hold_ns) || hold_ns < 0 ||
+        SyncDelayCode(hold_ns) > kHoldMaxCode) {
+      c.Fail("arrival_ns", -1,
+             "= " + std::to_string(e.arrival_ns) +
+                 ": the hold (send time - arrival) is outside " + delay_range(kHoldMaxCode));
+    }
+  }
   return c.status();
 }
 

@@ -100,7 +100,7 @@ Status SwarmReplay::Broadcast(int drone, int64_t now_ns) {
                                  ? std::get<net::EgoStateMessage>(m).stamp_ns
                                  : now_ns;
     const int64_t stamp_ns = runners_[drone]->input().true_clock.ToTrue(local_ns);
-    SWARMLIO_RETURN_IF_ERROR(channels_[drone]->Send(stamp_ns, net::kBroadcastId, m));
+    SWARMLIO_RETURN_IF_ERROR(channels_[drone]->Send(stamp_ns, net::kBroadcastId, m, local_ns));
     ++traffic_[drone].sent;
   }
   return Status::Ok();

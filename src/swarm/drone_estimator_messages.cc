@@ -105,6 +105,7 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
       impl_->clock_sync->RemoveTeammate(m->sender_id);
     }
     impl_->clock_sync->AddTeammate(m->sender_id, received.arrival_ns);
+    impl_->clock_sync->NoteTeammateState(*received_state, received.arrival_ns);
     if (!impl_->clock_sync->ToLocal(m->sender_id, received_state->stamp_ns, &local_state.stamp_ns)) {
       ++counters_.messages_unsynchronized;
       return Status::Ok();
@@ -300,7 +301,15 @@ void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState&
   }
   im.repeat.clear();
   RememberForRepeat(m, x, P);
-  if (m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite()) im.messages.push_back(m);
+  if (m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite()) {
+    if (im.clock_sync != nullptr) {
+      // Clock synchronisation in the broadcast: teammates' states echoed back
+      // (the send delay is set when the packet leaves, MessageChannel::Send).
+      im.clock_sync->EchoesFor(t_k, &m.echoes);
+      im.clock_sync->NoteOwnState(t_k);
+    }
+    im.messages.push_back(m);
+  }
 
   // The own T_Gi_Gj estimates, every extrinsic_broadcast_period_s and right
   // after a new identification (teammates use them to identify this drone).

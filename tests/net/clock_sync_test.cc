@@ -14,6 +14,7 @@
 
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/net/packet_codec.h"
+#include "tests/net/net_test_util.h"
 
 namespace swarmlio::net {
 namespace {
@@ -165,11 +166,17 @@ TEST(ClockOffsetEstimator, AStepOfTheTeammateClockRestartsTheFit) {
 }
 
 // ---------------------------------------------------------------------------
-// Scheduler and matching
+// Scheduler and matching (exchange = requests)
+
+ClockSyncOptions Requests() {
+  ClockSyncOptions options;
+  options.exchange = ClockExchange::kRequests;
+  return options;
+}
 
 TEST(ClockSync, SchedulesABurstThenOneRequestPerPeriod) {
   std::unique_ptr<ClockSync> sync;
-  ASSERT_TRUE(ClockSync::Create(0, ClockSyncOptions(), &sync).ok());
+  ASSERT_TRUE(ClockSync::Create(0, Requests(), &sync).ok());
   EXPECT_EQ(sync->NextRequestNs(), std::numeric_limits<int64_t>::max());
   const int64_t t0 = 100 * kS;
   sync->AddTeammate(1, t0);
@@ -203,7 +210,7 @@ TEST(ClockSync, SchedulesABurstThenOneRequestPerPeriod) {
 TEST(ClockSync, SlowsDownOnceTheOffsetIsSettled) {
   for (const bool answered : {true, false}) {
     std::unique_ptr<ClockSync> sync;
-    ASSERT_TRUE(ClockSync::Create(0, ClockSyncOptions(), &sync).ok());
+    ASSERT_TRUE(ClockSync::Create(0, Requests(), &sync).ok());
     const int64_t t0 = 100 * kS;
     sync->AddTeammate(1, t0);
     std::vector<int64_t> times;
@@ -239,7 +246,7 @@ TEST(ClockSync, SlowsDownOnceTheOffsetIsSettled) {
 }
 
 TEST(ClockSync, MatchesResponsesByT1AndCountsTheRest) {
-  ClockSyncOptions options;
+  ClockSyncOptions options = Requests();
   options.response_timeout_s = 1.0;
   std::unique_ptr<ClockSync> a, b;
   ASSERT_TRUE(ClockSync::Create(0, options, &a).ok());
@@ -310,7 +317,7 @@ TEST(ClockSync, MatchesResponsesByT1AndCountsTheRest) {
 }
 
 TEST(ClockSync, DisplacesTheOldestOutstandingRequest) {
-  ClockSyncOptions options;
+  ClockSyncOptions options = Requests();
   options.burst_requests = 0;
   options.request_period_s = 0.1;
   options.response_timeout_s = 10.0;
@@ -326,6 +333,102 @@ TEST(ClockSync, DisplacesTheOldestOutstandingRequest) {
 
 // ---------------------------------------------------------------------------
 // Drones with offset and drifting clocks over the simulated network
+
+// ---------------------------------------------------------------------------
+// State echo (exchange = state_echo, the default)
+
+/// A state of `sender` at `stamp_ns` as the wire carries it.
+EgoStateMessage StateAt(int sender, int64_t stamp_ns, int64_t send_delay_ns) {
+  EgoStateMessage m = net_test::MakeRawEgoState(sender, 0, 1);
+  m.stamp_ns = stamp_ns;
+  m.session_start_ns = stamp_ns;
+  m.send_delay_ns = send_delay_ns;
+  return m;
+}
+
+TEST(ClockSync, StateEchoTurnsTwoBroadcastsIntoAnExchange) {
+  std::unique_ptr<ClockSync> a, b;
+  ASSERT_TRUE(ClockSync::Create(0, ClockSyncOptions(), &a).ok());
+  ASSERT_TRUE(ClockSync::Create(1, ClockSyncOptions(), &b).ok());
+  const int64_t offset = 300 * kMs + 12345;  // b's clock = a's + offset
+  const int64_t latency = 5 * kMs;           // both ways
+  a->AddTeammate(1, 10 * kS);
+  b->AddTeammate(0, 10 * kS + offset);
+  std::vector<TimeSyncMessage> requests;
+  a->DueRequests(10 * kS, &requests);
+  EXPECT_TRUE(requests.empty());  // no TimeSync packets
+  EXPECT_EQ(a->NextRequestNs(), std::numeric_limits<int64_t>::max());
+
+  // a's state at 10 s, sent 7 ms later; it arrives at b after the latency.
+  const int64_t a_stamp = 10 * kS;
+  a->NoteOwnState(a_stamp);
+  const EgoStateMessage from_a = StateAt(0, a_stamp, 7 * kMs);
+  const int64_t b_arrival = a_stamp + 7 * kMs + latency + offset;
+  b->NoteTeammateState(from_a, b_arrival);
+  // b's next state (stamped after the arrival) echoes it, sent 3 ms later.
+  const int64_t b_stamp = b_arrival + 60 * kMs;
+  EgoStateMessage from_b = StateAt(1, b_stamp, 3 * kMs);
+  b->EchoesFor(b_stamp, &from_b.echoes);
+  b->NoteOwnState(b_stamp);
+  ASSERT_EQ(from_b.echoes.size(), 1u);
+  EXPECT_EQ(from_b.echoes[0].teammate_id, 0);
+  EXPECT_EQ(from_b.echoes[0].stamp_ref, StateEchoRef(a_stamp));
+  EXPECT_EQ(from_b.echoes[0].send_delay_ns, 7 * kMs);
+  EXPECT_EQ(from_b.echoes[0].arrival_ns, b_arrival);
+  from_b = net_test::OnTheWire(from_b);  // quantized as sent
+  const int64_t a_arrival = b_stamp + 3 * kMs + latency - offset;
+  a->NoteTeammateState(from_b, a_arrival);
+  const ClockOffsetEstimate e = a->Estimate(1, a_arrival);
+  ASSERT_TRUE(e.valid);
+  EXPECT_NEAR(static_cast<double>(e.offset_ns), static_cast<double>(offset), 10000.0);  // 10 us steps
+  EXPECT_NEAR(static_cast<double>(e.min_delay_ns), 2.0 * latency, 20000.0);
+  EXPECT_EQ(a->Stats(1).echoes_matched, 1u);
+  EXPECT_EQ(b->Stats(0).echoes_sent, 1u);
+  // The same state is not echoed twice; an echo of a state a never sent is
+  // counted, not used.
+  std::vector<StateEcho> again;
+  b->EchoesFor(b_stamp + kS, &again);
+  EXPECT_TRUE(again.empty());
+  from_b.echoes[0].stamp_ref = static_cast<uint16_t>(from_b.echoes[0].stamp_ref + 1);
+  a->NoteTeammateState(from_b, a_arrival + 1);
+  EXPECT_EQ(a->Stats(1).echoes_unmatched, 1u);
+  EXPECT_EQ(a->Estimate(1, a_arrival).num_samples, 1);
+}
+
+TEST(ClockSync, EchoesRotateWithinTheirBudget) {
+  ClockSyncOptions options;
+  options.max_echoes_per_state = 2;
+  options.echo_period_s = 0.2;
+  options.max_echo_age_s = 0.4;
+  std::unique_ptr<ClockSync> sync;
+  ASSERT_TRUE(ClockSync::Create(0, options, &sync).ok());
+  for (int j = 1; j <= 5; ++j) sync->AddTeammate(j, 0);
+  std::vector<int> echoed(6, 0);
+  int64_t max_per_state = 0;
+  // Every teammate's state arrives every 100 ms; ours go out every 100 ms.
+  for (int64_t t = kS; t < 11 * kS; t += 100 * kMs) {
+    for (int j = 1; j <= 5; ++j) sync->NoteTeammateState(StateAt(j, t - j * kMs, 0), t - kMs);
+    std::vector<StateEcho> echoes;
+    sync->EchoesFor(t, &echoes);
+    max_per_state = std::max<int64_t>(max_per_state, static_cast<int64_t>(echoes.size()));
+    for (const StateEcho& e : echoes) ++echoed[static_cast<size_t>(e.teammate_id)];
+  }
+  EXPECT_EQ(max_per_state, 2);
+  // 100 states x 2 echoes shared by 5 teammates, evenly.
+  for (int j = 1; j <= 5; ++j) EXPECT_NEAR(echoed[static_cast<size_t>(j)], 40, 1) << j;
+  // A state older than max_echo_age_s is not echoed.
+  std::vector<StateEcho> late;
+  sync->EchoesFor(20 * kS, &late);
+  EXPECT_TRUE(late.empty());
+  // Requests mode: no echoes.
+  std::unique_ptr<ClockSync> requests;
+  ASSERT_TRUE(ClockSync::Create(0, Requests(), &requests).ok());
+  requests->AddTeammate(1, 0);
+  requests->NoteTeammateState(StateAt(1, kS, 0), kS);
+  std::vector<StateEcho> none;
+  requests->EchoesFor(kS + kMs, &none);
+  EXPECT_TRUE(none.empty());
+}
 
 }  // namespace
 }  // namespace swarmlio::net

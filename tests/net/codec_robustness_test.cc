@@ -156,7 +156,7 @@ constexpr size_t kEgoPosition = kHeaderBytes + 21;
 constexpr size_t kEgoVelocity = kHeaderBytes + 33;
 constexpr size_t kEgoOmega = kHeaderBytes + 39;
 constexpr size_t kEgoCovP = kHeaderBytes + 51;
-constexpr size_t kEgoFirstObservation = kHeaderBytes + kEgoStateFixedBytes;
+constexpr size_t kEgoFirstEcho = kHeaderBytes + kEgoStateFixedBytes;
 
 void PutU16(std::vector<uint8_t>* p, size_t at, uint16_t value) {
   (*p)[at] = static_cast<uint8_t>(value & 0xFF);
@@ -196,7 +196,7 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
   }
   {  // past observations: count against the bytes, the cap, a zero age, the sender's own id
     const std::vector<uint8_t> past = Encode(MakeEgoState(1, 2, 5, 2));
-    const size_t count_at = kEgoFirstObservation + 2 * kObservationBytes;
+    const size_t count_at = kEgoFirstEcho + 2 * kObservationBytes;  // no echoes
     std::vector<uint8_t> p = past;
     Resign(&p);
     ASSERT_TRUE(Decode(p).ok());
@@ -221,6 +221,36 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
     p[count_at + 1] = 1;  // the first entry observed the sender itself
     Resign(&p);
     ExpectRejected(p, "past_observations[0].observed_id' = 1 is the sender itself");
+  }
+  {  // clock echoes: the cap, an unknown send delay, the sender's own id, a bad delay code,
+     // a count larger than the bytes
+    const std::vector<uint8_t> echo = Encode(MakeEgoState(1, 2, 5, 0, 2));
+    const size_t delay_at = kEgoFirstEcho - 3;
+    const size_t count_at = kEgoFirstEcho - 1;
+    std::vector<uint8_t> p = echo;
+    Resign(&p);
+    ASSERT_TRUE(Decode(p).ok());
+    ASSERT_EQ(p[count_at], 2);
+    p[count_at] = EgoStateMessage::kMaxEchoes + 1;
+    p.insert(p.end() - kTagBytes, (EgoStateMessage::kMaxEchoes - 1) * kStateEchoBytes, 0);
+    Resign(&p);
+    ExpectRejected(p, "echo count 9 exceeds the maximum 8");
+    p = echo;
+    PutU16(&p, delay_at, 65535);
+    Resign(&p);
+    ExpectRejected(p, "echo count 2 with an unknown send delay");
+    p = echo;
+    p[kEgoFirstEcho] = 1;  // the first echo names the sender itself
+    Resign(&p);
+    ExpectRejected(p, "echoes[0].teammate_id' = 1 is the sender itself");
+    p = echo;
+    PutU16(&p, kEgoFirstEcho + 3, 65535);  // the first echo's send delay
+    Resign(&p);
+    ExpectRejected(p, "echoes[0]: send delay code 65535 is not a known delay");
+    p = echo;
+    p[count_at] = 3;
+    Resign(&p);
+    ExpectRejected(p, "observation count 2 needs");
   }
   {  // a payload shorter than the fixed part
     std::vector<uint8_t> p = ego;
@@ -275,7 +305,7 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
     Resign(&p);
     ExpectRejected(p, "session_start_ns' is negative");
   }
-  const size_t first = kEgoFirstObservation;
+  const size_t first = kEgoFirstEcho;  // the first observation (no echoes)
   {  // observed id out of range
     std::vector<uint8_t> p = ego;
     p[first] = 200;

@@ -20,7 +20,8 @@ using net_test::MakeTimeSync;
 
 size_t ExpectedPacketBytes(const SwarmMessage& m) {
   if (const auto* e = std::get_if<EgoStateMessage>(&m)) {
-    return EgoStatePacketBytes(e->observations.size(), e->past_observations.size());
+    return EgoStatePacketBytes(e->observations.size(), e->past_observations.size(),
+                               e->echoes.size());
   }
   if (const auto* g = std::get_if<GlobalExtrinsicMessage>(&m)) {
     return GlobalExtrinsicPacketBytes(g->entries.size());
@@ -58,14 +59,16 @@ TEST(PacketCodec, EveryMessageRoundTripsBitExactly) {
 TEST(PacketCodec, DocumentedSizes) {
   // docs/network.md, "Messages and their sizes".
   EXPECT_EQ(kPacketOverheadBytes, 22u);
-  EXPECT_EQ(EgoStatePacketBytes(0), 85u);
-  EXPECT_EQ(EgoStatePacketBytes(1), 98u);
-  EXPECT_EQ(EgoStatePacketBytes(2), 111u);
-  EXPECT_EQ(EgoStatePacketBytes(4), 137u);
-  EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 397u);
-  EXPECT_EQ(EgoStatePacketBytes(1, 1), 114u);  // one observation, repeated in the next
+  EXPECT_EQ(EgoStatePacketBytes(0), 88u);
+  EXPECT_EQ(EgoStatePacketBytes(1), 101u);
+  EXPECT_EQ(EgoStatePacketBytes(2), 114u);
+  EXPECT_EQ(EgoStatePacketBytes(4), 140u);
+  EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 400u);
+  EXPECT_EQ(EgoStatePacketBytes(1, 1), 117u);  // one observation, repeated in the next
+  EXPECT_EQ(EgoStatePacketBytes(1, 0, 1), 108u);  // one observation, one clock echo
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
-                                EgoStateMessage::kMaxPastObservations), 758u);
+                                EgoStateMessage::kMaxPastObservations,
+                                EgoStateMessage::kMaxEchoes), 817u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(0), 49u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 90u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 377u);

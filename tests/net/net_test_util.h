@@ -66,7 +66,7 @@ class ValueSource {
 };
 
 inline EgoStateMessage MakeRawEgoState(int sender, int num_observations, uint64_t seed,
-                                       int num_past_observations = 0) {
+                                       int num_past_observations = 0, int num_echoes = 0) {
   ValueSource v(seed);
   EgoStateMessage m;
   m.sender_id = sender;
@@ -97,6 +97,17 @@ inline EgoStateMessage MakeRawEgoState(int sender, int num_observations, uint64_
     o.p_bk_in_Gj = m.p_bj_in_Gj + v.Vector32(20.0);
     o.cov_p_bk_in_Gj = v.Covariance<3>(1e-3);
     m.past_observations.push_back(o);
+    ++i;
+  }
+  if (num_echoes > 0) m.send_delay_ns = static_cast<int64_t>(v.Next() % 600'000'000);
+  for (int i = 0, id = 0; i < num_echoes; ++id) {
+    if (id == sender) continue;
+    StateEcho e;
+    e.teammate_id = id;
+    e.stamp_ref = static_cast<uint16_t>(v.Next() & 0xFFFF);
+    e.send_delay_ns = static_cast<int64_t>(v.Next() % 600'000'000);
+    e.arrival_ns = m.stamp_ns + m.send_delay_ns - static_cast<int64_t>(v.Next() % 600'000'000);
+    m.echoes.push_back(e);
     ++i;
   }
   return m;
@@ -148,8 +159,9 @@ Message OnTheWire(const Message& message) {
 }
 
 inline EgoStateMessage MakeEgoState(int sender, int num_observations, uint64_t seed,
-                                    int num_past_observations = 0) {
-  return OnTheWire(MakeRawEgoState(sender, num_observations, seed, num_past_observations));
+                                    int num_past_observations = 0, int num_echoes = 0) {
+  return OnTheWire(
+      MakeRawEgoState(sender, num_observations, seed, num_past_observations, num_echoes));
 }
 
 inline GlobalExtrinsicMessage MakeGlobalExtrinsic(int sender, int num_entries, uint64_t seed) {
@@ -196,6 +208,14 @@ inline void ExpectSameMessage(const SwarmMessage& expected, const SwarmMessage& 
       EXPECT_EQ(e->past_observations[i].p_bk_in_Gj, a.past_observations[i].p_bk_in_Gj);
       EXPECT_EQ(e->past_observations[i].cov_p_bk_in_Gj, a.past_observations[i].cov_p_bk_in_Gj);
     }
+    EXPECT_EQ(e->send_delay_ns, a.send_delay_ns);
+    ASSERT_EQ(e->echoes.size(), a.echoes.size());
+    for (size_t i = 0; i < e->echoes.size(); ++i) {
+      EXPECT_EQ(e->echoes[i].teammate_id, a.echoes[i].teammate_id);
+      EXPECT_EQ(e->echoes[i].stamp_ref, a.echoes[i].stamp_ref);
+      EXPECT_EQ(e->echoes[i].send_delay_ns, a.echoes[i].send_delay_ns);
+      EXPECT_EQ(e->echoes[i].arrival_ns, a.echoes[i].arrival_ns);
+    }
   } else if (const auto* g = std::get_if<GlobalExtrinsicMessage>(&expected)) {
     const auto& a = std::get<GlobalExtrinsicMessage>(actual);
     EXPECT_EQ(g->sender_id, a.sender_id);
@@ -231,6 +251,10 @@ inline std::vector<SwarmMessage> AllExampleMessages() {
   messages.push_back(MakeEgoState(3, 1, 150, 1));  // with repeated observations
   messages.push_back(MakeEgoState(3, EgoStateMessage::kMaxObservations, 151,
                                   EgoStateMessage::kMaxPastObservations));
+  messages.push_back(MakeEgoState(3, 1, 152, 0, 2));  // with clock echoes
+  messages.push_back(MakeEgoState(3, EgoStateMessage::kMaxObservations, 153,
+                                  EgoStateMessage::kMaxPastObservations,
+                                  EgoStateMessage::kMaxEchoes));
   for (int n : {0, 1, GlobalExtrinsicMessage::kMaxEntries}) {
     messages.push_back(MakeGlobalExtrinsic(63, n, 200 + static_cast<uint64_t>(n)));
   }

@@ -161,7 +161,8 @@ TEST_F(SwarmEndToEndTest, RepeatedObservationsReplaceLostOnesAndNeverCountTwice)
 
 // The same flight with the drones' clocks 0.5 s apart and drifting (the
 // live-swarm fault of docs/network.md): each drone estimates its teammates'
-// offsets from TimeSync exchanges and maps their stamps onto its own clock,
+// offsets from the timestamps and echoes in the state broadcasts (the
+// default exchange) and maps their stamps onto its own clock,
 // so the Avia is held as with agreeing clocks, and every offset is known
 // within 2 ms. Taking the stamps as they come (synchronize_clocks off), the
 // Avia's observations are half a second off; on indoor_3uav that tripled

@@ -91,14 +91,16 @@ TEST(DroneEstimator, IgnoresOwnForeignTypedAndNonFiniteMessages) {
   EXPECT_EQ(e->counters().messages_ignored, 3);
 }
 
-// A teammate's states wait for its clock offset; the TimeSync requests and
-// answers leave with the send time (the newest sensor stamp).
+// A teammate's states wait for its clock offset; with exchange = requests the
+// TimeSync requests and answers leave with the send time (the newest sensor
+// stamp). (The default state echo is tested end to end: SwarmClockTest.)
 TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
   sim::Scenario scenario = IndoorScenario();
   ASSERT_FALSE(scenario.drones.empty());
   const sim::DroneConfig& d = scenario.drones[0];
   DroneEstimatorOptions o = OptionsFor(d);
   o.swarm.synchronize_clocks = true;
+  o.swarm.clock_sync.exchange = net::ClockExchange::kRequests;
   std::unique_ptr<DroneEstimator> e;
   ASSERT_TRUE(DroneEstimator::Create(0, o, d.lidar.sensor, &e).ok());
   const int64_t t0 = 1'000'000'000'000;  // 1000 s on the own clock

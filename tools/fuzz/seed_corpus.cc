@@ -19,7 +19,8 @@ Eigen::Matrix3d Covariance3(double scale) {
   return scale * c;
 }
 
-net::EgoStateMessage EgoState(int sender, int num_observations, int num_past = 0) {
+net::EgoStateMessage EgoState(int sender, int num_observations, int num_past = 0,
+                              int num_echoes = 0) {
   net::EgoStateMessage m;
   m.sender_id = sender;
   m.stamp_ns = 1'700'000'000'123'456'789;
@@ -48,6 +49,16 @@ net::EgoStateMessage EgoState(int sender, int num_observations, int num_past = 0
     o.p_bk_in_Gj = m.p_bj_in_Gj + Eigen::Vector3d(-3.0 + id, 2.0, 0.25 * id);
     o.cov_p_bk_in_Gj = Covariance3(2e-3 * (1 + id));
     m.past_observations.push_back(o);
+  }
+  if (num_echoes > 0) m.send_delay_ns = 12'340'000;
+  for (int id = 0; static_cast<int>(m.echoes.size()) < num_echoes; ++id) {
+    if (id == sender) continue;
+    net::StateEcho e;
+    e.teammate_id = id;
+    e.stamp_ref = static_cast<uint16_t>(1000 * id + 7);
+    e.send_delay_ns = 3'000'000 + 10'000 * id;
+    e.arrival_ns = m.stamp_ns + m.send_delay_ns - 40'000'000 - 1'000'000 * id;
+    m.echoes.push_back(e);
   }
   return m;
 }
@@ -108,7 +119,7 @@ Status WriteFile(const std::string& path, const std::vector<uint8_t>& bytes) {
 
 std::vector<net::SwarmMessage> SeedMessages() {
   return {EgoState(3, 0),        EgoState(3, 1),        EgoState(3, 2),
-          EgoState(7, 5),        EgoState(63, 24),      EgoState(3, 1, 1),
+          EgoState(7, 5),        EgoState(63, 24),      EgoState(3, 1, 1),      EgoState(3, 1, 0, 2),   EgoState(9, 24, 24, 8),
           EgoState(9, 24, 24),   GlobalExtrinsic(5, 0),
           GlobalExtrinsic(5, 1), GlobalExtrinsic(2, 3), GlobalExtrinsic(0, 8),
           TimeSync(1, 2, false), TimeSync(2, 1, true)};

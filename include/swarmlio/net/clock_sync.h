@@ -35,11 +35,14 @@
 // (int64 ns, docs/conventions.md). One thread uses a ClockSync at a time.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "swarmlio/common/status.h"
@@ -48,9 +51,37 @@
 
 namespace swarmlio::net {
 
+/// How the four timestamps of an exchange travel.
+enum class ClockExchange {
+  kStateEcho,  // in the EgoState broadcasts: each state carries its send delay and echoes
+               // of teammates' states (wire version 5; no extra packets, cost independent of N)
+  kRequests,   // TimeSync request/response packets per teammate (2 (N-1) packets per period)
+};
+
+}  // namespace swarmlio::net
+
+namespace swarmlio::config {
+template <>
+struct EnumTraits<net::ClockExchange> {
+  static constexpr std::array<std::pair<net::ClockExchange, const char*>, 2> kNames{{
+      {net::ClockExchange::kStateEcho, "state_echo"},
+      {net::ClockExchange::kRequests, "requests"},
+  }};
+};
+}  // namespace swarmlio::config
+
+namespace swarmlio::net {
+
 /// YAML section `clock_sync`.
 struct ClockSyncOptions {
-  double request_period_s = 1.0;     // one request per teammate per period [s]
+  ClockExchange exchange = ClockExchange::kStateEcho;
+  double echo_period_s = 0.2;        // state echo: each teammate's state echoed at most this
+                                     // often [s]
+  int max_echoes_per_state = 2;      // state echo: echoes per EgoState (bounds the bytes for
+                                     // any swarm size)
+  double max_echo_age_s = 0.4;       // state echo: a teammate state older than this when our
+                                     // state is made is not echoed [s]
+  double request_period_s = 1.0;     // requests: one request per teammate per period [s]
   double settled_request_period_s = 10.0;  // ... once the offset std is below settled_std_s [s]
   double settled_std_s = 0.5e-3;           // (at the end of that period; NTP's poll interval
                                            // growth; 0 = never settle) [s]
@@ -69,6 +100,15 @@ struct ClockSyncOptions {
   template <class V>
   void VisitFields(V&& v) {
     using config::FieldSpec;
+    v("exchange", exchange,
+      FieldSpec::Doc("state_echo (timestamps in the state broadcasts) or requests (TimeSync "
+                     "packets per teammate)"));
+    v("echo_period_s", echo_period_s,
+      FieldSpec::InRange(0.01, 3600.0, "s", "state echo: a teammate's state echoed at most this often"));
+    v("max_echoes_per_state", max_echoes_per_state,
+      FieldSpec::InRange(1, EgoStateMessage::kMaxEchoes, "", "state echo: echoes per EgoState"));
+    v("max_echo_age_s", max_echo_age_s,
+      FieldSpec::InRange(0.001, 0.5, "s", "state echo: oldest teammate state that is echoed"));
     v("request_period_s", request_period_s,
       FieldSpec::Positive("s", "interval between requests to one teammate").WithMax(3600.0));
     v("settled_request_period_s", settled_request_period_s,
@@ -108,10 +148,11 @@ struct TimeSyncSample {
 };
 
 /// Reduces an exchange. InvalidArgument when t4 < t1, t3 < t2, the round trip
-/// is negative beyond the drift tolerance (2e-4 of t3 - t2, plus 1 us), or an
+/// is negative beyond the drift tolerance (2e-4 of t3 - t2, plus 1 us, plus
+/// 2 `stamp_step_ns` for stamps that travel rounded to that step), or an
 /// intermediate value overflows int64.
-Status ReduceTimeSyncExchange(
-    int64_t t1_ns, int64_t t2_ns, int64_t t3_ns, int64_t t4_ns, TimeSyncSample* sample);
+Status ReduceTimeSyncExchange(int64_t t1_ns, int64_t t2_ns, int64_t t3_ns, int64_t t4_ns,
+                              TimeSyncSample* sample, int64_t stamp_step_ns = 0);
 
 /// The offset of one teammate's clock at a query time.
 struct ClockOffsetEstimate {
@@ -174,6 +215,9 @@ class ClockOffsetEstimator {
 
 /// Counters of one teammate.
 struct ClockSyncStats {
+  uint64_t echoes_sent = 0;          // its states echoed in ours
+  uint64_t echoes_matched = 0;       // its echoes of our states that became a sample
+  uint64_t echoes_unmatched = 0;     // echoes of a state we do not remember sending
   uint64_t requests_sent = 0;
   uint64_t requests_timed_out = 0;   // no response within response_timeout_s, or displaced
   uint64_t responses_matched = 0;    // became a sample
@@ -200,10 +244,25 @@ class ClockSync {
   void RemoveTeammate(int teammate_id);
   bool HasTeammate(int teammate_id) const { return teammates_.count(teammate_id) != 0; }
 
-  /// Appends the requests due at `now_ns` (at most one per teammate, t1 =
+  /// State echo (exchange = state_echo; no-ops otherwise). Our state stamped
+  /// `stamp_ns` is going out (a teammate's echo names it by StateEchoRef).
+  void NoteOwnState(int64_t stamp_ns);
+  /// Teammate j's state arrived at `arrival_ns` (j must be added first): kept
+  /// to be echoed back, and j's echo of one of our states becomes a sample
+  /// (t1 = our stamp + the echoed send delay, t2 = the echo's arrival, t3 =
+  /// j's stamp + its send delay, t4 = arrival_ns). Bad input never fails.
+  void NoteTeammateState(const EgoStateMessage& state, int64_t arrival_ns);
+  /// The echoes for our state made at `now_ns`: teammates whose newest state
+  /// is not echoed yet, arrived within max_echo_age_s and was last echoed
+  /// echo_period_s ago or earlier; the least recently echoed first, at most
+  /// max_echoes_per_state.
+  void EchoesFor(int64_t now_ns, std::vector<StateEcho>* echoes);
+
+  /// Requests only (none with exchange = state_echo):
+  /// appends the requests due at `now_ns` (at most one per teammate, t1 =
   /// now_ns) and records them as sent: send each one at `now_ns`.
   void DueRequests(int64_t now_ns, std::vector<TimeSyncMessage>* requests);
-  /// When the next request is due (INT64_MAX without teammates).
+  /// When the next request is due (INT64_MAX without teammates or requests).
   int64_t NextRequestNs() const;
 
   /// Handles an authenticated TimeSync message (ReceivedMessage::message)
@@ -232,11 +291,22 @@ class ClockSync {
     int64_t next_request_ns = 0;
     int burst_remaining = 0;
     std::deque<int64_t> outstanding;  // t1 of requests in flight, ascending
+    // State echo: its newest state (to echo back) and when we last echoed one.
+    bool state_to_echo = false;
+    int64_t state_stamp_ns = 0;
+    int64_t state_send_delay_ns = 0;
+    int64_t state_arrival_ns = 0;
+    int64_t last_echo_ns = std::numeric_limits<int64_t>::min();
+    uint64_t echo_order = 0;  // echoes_made_ at its last echo (0 = never): rotation order
     ClockOffsetEstimator estimator;
     ClockSyncStats stats;
   };
   ClockSync(int self_id, const ClockSyncOptions& options);
   void ExpireRequests(int64_t now_ns, Teammate* teammate) const;
+  /// Adds one exchange's sample; false if its stamps are invalid.
+  bool AddExchange(int64_t t1_ns, int64_t t2_ns, int64_t t3_ns, int64_t t4_ns,
+                   int64_t stamp_step_ns, Teammate* teammate);
+  bool echo_mode() const { return options_.exchange == ClockExchange::kStateEcho; }
 
   int self_id_;
   ClockSyncOptions options_;
@@ -245,6 +315,8 @@ class ClockSync {
   int64_t burst_period_ns_;
   int64_t timeout_ns_;
   std::map<int, Teammate> teammates_;  // ordered: deterministic request order
+  std::deque<int64_t> own_stamps_;     // our last kOwnStates state stamps (state echo)
+  uint64_t echoes_made_ = 0;
   uint64_t requests_answered_ = 0;
 };
 

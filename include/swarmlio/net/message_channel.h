@@ -35,6 +35,8 @@ struct ChannelStats {
   uint64_t rejected = 0;     // failed decoding or authentication
   uint64_t duplicates = 0;   // same (sender, sequence) seen recently
   uint64_t own_packets = 0;  // our own packets echoed back (UDP broadcast)
+  uint64_t send_delay_unknown = 0;  // EgoStates sent later than the wire's send delay range
+  uint64_t echoes_dropped = 0;      // state echoes whose hold left the wire's range
   std::string last_reject_reason;
 };
 
@@ -49,7 +51,19 @@ class MessageChannel {
 
   /// Encodes and sends; InvalidArgument if the message's sender is not this
   /// endpoint or the message breaks a codec rule; transport errors pass through.
-  Status Send(int64_t now_ns, int destination_id, const SwarmMessage& message);
+  /// `now_ns` is the transport's time. An EgoState gets its send time here:
+  /// send_delay_ns = local_now_ns - stamp_ns (the clock synchronisation's
+  /// t1/t3, docs/network.md section 9), `local_now_ns` being the time the
+  /// packet really leaves on the sender's clock (the clock of its stamps; the
+  /// same as now_ns unless the transport runs on another time line, as the
+  /// replay's true time does). When that delay, or an echo's hold, is outside
+  /// the wire's range, the delay is sent as not known (and the echoes
+  /// dropped) or the echo dropped, and counted.
+  Status Send(int64_t now_ns, int destination_id, const SwarmMessage& message) {
+    return Send(now_ns, destination_id, message, now_ns);
+  }
+  Status Send(int64_t now_ns, int destination_id, const SwarmMessage& message,
+              int64_t local_now_ns);
 
   /// Appends the messages that arrived by `now_ns`, in arrival order.
   Status Poll(int64_t now_ns, std::vector<ReceivedMessage>* messages);
@@ -58,6 +72,7 @@ class MessageChannel {
   int self_id() const { return transport_->self_id(); }
 
  private:
+  void StampSendTime(int64_t now_ns, EgoStateMessage* m);
   struct RecentSequences {
     std::array<uint32_t, kDuplicateWindow> ring{};
     int count = 0;

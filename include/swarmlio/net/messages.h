@@ -45,6 +45,26 @@ struct PastObservation {
   Eigen::Matrix3d cov_p_bk_in_Gj = Eigen::Matrix3d::Zero();  // [m^2]
 };
 
+/// A teammate k's state that drone j received, echoed back in j's next
+/// state so that k gets a four-timestamp clock exchange out of the two
+/// broadcasts (docs/network.md, "Clock synchronisation"): k sent it at
+/// t1 = k's stamp + send_delay_ns (k's clock), it arrived at j at
+/// t2 = arrival_ns, j's state left at t3 = j's stamp + j's send_delay_ns (both
+/// j's clock), and k stamps t4 when j's state arrives.
+struct StateEcho {
+  int teammate_id = 0;       // k
+  uint16_t stamp_ref = 0;    // StateEchoRef(k's stamp_ns): which of k's states
+  int64_t send_delay_ns = 0; // that state's send delay as k sent it [ns]
+  int64_t arrival_ns = 0;    // when it arrived at j (j's clock) [ns]
+};
+
+/// The reference a StateEcho carries for a state stamped `stamp_ns`: its
+/// stamp in whole milliseconds modulo 2^16 (unique over 65 s of states).
+inline uint16_t StateEchoRef(int64_t stamp_ns) {
+  const int64_t ms = stamp_ns / 1000000 - (stamp_ns % 1000000 < 0 ? 1 : 0);  // floor
+  return static_cast<uint16_t>(static_cast<uint64_t>(ms) & 0xFFFFu);
+}
+
 /// Drone j's ego state at `stamp_ns` (j's clock), sent after every scan.
 /// The covariance blocks are the ones a receiver k needs for the active and
 /// passive observation terms and for propagating j to k's scan time with
@@ -56,6 +76,8 @@ struct EgoStateMessage {
   static constexpr int kMaxObservations = 24;
   /// Upper bound on past observations per message.
   static constexpr int kMaxPastObservations = 24;
+  /// Upper bound on echoed teammate states per message.
+  static constexpr int kMaxEchoes = 8;
 
   int sender_id = 0;             // j
   int64_t stamp_ns = 0;          // state time, j's clock [ns]
@@ -71,6 +93,12 @@ struct EgoStateMessage {
   bool degenerated = false;                       // j's last scan was LiDAR-degenerate
   std::vector<TeammateObservation> observations;  // distinct ids, none == sender_id
   std::vector<PastObservation> past_observations;  // distinct ids, none == sender_id
+  /// When the packet left j: stamp_ns + send_delay_ns (j's clock); -1 = not
+  /// known. MessageChannel::Send sets it from its now_ns (wire version 5).
+  int64_t send_delay_ns = -1;
+  /// Teammates' states j received, echoed for their clock synchronisation
+  /// (distinct ids, none == sender_id; only with send_delay_ns >= 0).
+  std::vector<StateEcho> echoes;
 };
 
 /// How the sender obtained a global extrinsic.

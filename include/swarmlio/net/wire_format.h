@@ -1,4 +1,4 @@
-// The swarm packet wire format, version 4 (docs/network.md, "Wire format").
+// The swarm packet wire format, version 5 (docs/network.md, "Wire format").
 //
 //   offset size field
 //   0      1    magic 'S' (0x53)
@@ -25,8 +25,9 @@ namespace swarmlio::net {
 
 inline constexpr uint8_t kMagic = 0x53;  // 'S'
 /// 2: gravity in GlobalExtrinsic; 3: quantized payloads, 6-byte header, 16-byte tag;
-/// 4: past observations at the end of EgoState.
-inline constexpr uint8_t kProtocolVersion = 4;
+/// 4: past observations at the end of EgoState; 5: send delay and state echoes in
+/// EgoState (clock synchronisation without TimeSync packets).
+inline constexpr uint8_t kProtocolVersion = 5;
 inline constexpr size_t kHeaderBytes = 6;
 inline constexpr size_t kTagBytes = 16;  // HMAC-SHA512-256 truncated to 128 bits
 inline constexpr size_t kPacketOverheadBytes = kHeaderBytes + kTagBytes;
@@ -71,12 +72,36 @@ constexpr size_t CovarianceBytes(size_t n) { return n + n * (n - 1) / 2; }
 //   bits u8 (0-1 q largest index, 2 degenerated, 3-7 observation count) |
 //   q_Gj_bj 3 x i16 | p_bj_in_Gj f32 x3 | v_bj_in_Gj f16 x3 | omega_bj_in_bj f16 x3 |
 //   cov_theta cov(3) | cov_p cov(3) | cov_v cov(3) |
+//   send delay u16 (10 us; 65535 = not known) | echo count u8 (0..kMaxEchoes) |
+//   echo count x { teammate id u8 | stamp ref u16 | its send delay u16 (10 us) |
+//                  hold u16 (10 us: this packet's send time - the echoed state's arrival) } |
 //   count x { observed id u8 | p_bk_in_bj 3 x i16 (2 mm) | cov(3) } |
 //   optional (version 4), present only when the message has past observations:
 //   past count u8 (1..kMaxPastObservations) |
 //   past count x { observed id u8 | age u16 (0.1 ms) |
 //                  p_bk_in_Gj - p_bj_in_Gj 3 x i16 (2 mm) | cov(3) }
-inline constexpr size_t kEgoStateFixedBytes = 8 + 6 + 1 + 6 + 12 + 6 + 6 + 3 * CovarianceBytes(3);
+inline constexpr size_t kEgoStateFixedBytes =
+    8 + 6 + 1 + 6 + 12 + 6 + 6 + 3 * CovarianceBytes(3) + 2 + 1;
+inline constexpr size_t kStateEchoBytes = 1 + 2 + 2 + 2;
+// Send delay, an echo's send delay and hold: uint16 code = round(ns / kSyncDelayStepNs).
+inline constexpr int64_t kSyncDelayStepNs = 10000;  // 10 us
+inline constexpr int kSendDelayMaxCode = 65534;     // 655.34 ms; 65535 = not known
+inline constexpr int kSendDelayUnknownCode = 65535;
+inline constexpr int kHoldMaxCode = 65535;          // 655.35 ms
+/// The code the writer sends for a send delay or hold (rounded; callers check the range).
+constexpr int64_t SyncDelayCode(int64_t ns) {
+  return (ns + kSyncDelayStepNs / 2) / kSyncDelayStepNs;
+}
+/// A send delay as it travels (rounded to kSyncDelayStepNs).
+constexpr int64_t QuantizedSyncDelayNs(int64_t ns) { return SyncDelayCode(ns) * kSyncDelayStepNs; }
+/// The hold of an echo: the send time of the state that carries it (stamp +
+/// the quantized send delay) - the echoed state's arrival. False on overflow.
+inline bool StateEchoHoldNs(int64_t stamp_ns, int64_t send_delay_ns, int64_t arrival_ns,
+                            int64_t* hold_ns) {
+  int64_t sent_ns = 0;
+  return !__builtin_add_overflow(stamp_ns, QuantizedSyncDelayNs(send_delay_ns), &sent_ns) &&
+         !__builtin_sub_overflow(sent_ns, arrival_ns, hold_ns);
+}
 inline constexpr size_t kObservationBytes = 1 + 6 + CovarianceBytes(3);
 inline constexpr size_t kPastObservationBytes = 1 + 2 + 6 + CovarianceBytes(3);
 // Past observation age: uint16 code = round(age_ns / kPastObservationAgeStepNs), 1..65535.
@@ -94,8 +119,10 @@ inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 6 + 12 + CovarianceBytes(
 // TimeSync: target id u8 | kind u8 (0 request, 1 response) | t1 t2 t3 i64
 inline constexpr size_t kTimeSyncBytes = 1 + 1 + 3 * 8;
 
-constexpr size_t EgoStatePacketBytes(size_t num_observations, size_t num_past_observations = 0) {
-  return kPacketOverheadBytes + kEgoStateFixedBytes + kObservationBytes * num_observations +
+constexpr size_t EgoStatePacketBytes(size_t num_observations, size_t num_past_observations = 0,
+                                     size_t num_echoes = 0) {
+  return kPacketOverheadBytes + kEgoStateFixedBytes + kStateEchoBytes * num_echoes +
+         kObservationBytes * num_observations +
          (num_past_observations > 0 ? 1 + kPastObservationBytes * num_past_observations : 0);
 }
 constexpr size_t GlobalExtrinsicPacketBytes(size_t num_entries) {
@@ -103,12 +130,15 @@ constexpr size_t GlobalExtrinsicPacketBytes(size_t num_entries) {
 }
 constexpr size_t TimeSyncPacketBytes() { return kPacketOverheadBytes + kTimeSyncBytes; }
 
-static_assert(kEgoStateFixedBytes == 63 && kObservationBytes == 13 && kPastObservationBytes == 15,
+static_assert(kEgoStateFixedBytes == 66 && kObservationBytes == 13 &&
+                  kPastObservationBytes == 15 && kStateEchoBytes == 7,
               "layout changed: update docs");
 static_assert(kGlobalExtrinsicFixedBytes == 27 && kExtrinsicEntryBytes == 41,
               "layout changed: update docs");
 static_assert(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
-                                  EgoStateMessage::kMaxPastObservations) <= kMaxPacketBytes);
+                                  EgoStateMessage::kMaxPastObservations,
+                                  EgoStateMessage::kMaxEchoes) <= kMaxPacketBytes);
+static_assert(EgoStateMessage::kMaxEchoes <= 255, "the echo count travels in one byte");
 static_assert(EgoStateMessage::kMaxPastObservations <= 255, "the past count travels in one byte");
 static_assert(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries) <= kMaxPacketBytes);
 static_assert(TimeSyncPacketBytes() <= kMaxPacketBytes);
