@@ -32,15 +32,20 @@ Status PushSource::Create(const PushSourceOptions& options, const Clock* clock,
 PushSource::~PushSource() = default;
 
 void PushSource::PushImu(const ImuSample& imu) {
-  Push(kImu, imu.stamp_ns, io::BagRecord{imu});
+  Push(kImu, imu.stamp_ns, imu.stamp_ns, io::BagRecord{imu});
 }
 
 void PushSource::PushScan(LidarScan scan) {
   const int64_t stamp_ns = scan.stamp_ns;
-  Push(kLidar, stamp_ns, io::BagRecord{std::move(scan)});
+  // The next scan starts after this one ends (an overlapping one is dropped
+  // by the odometry, offline as live): the stream has passed the scan end.
+  double span_s = 0.0;
+  for (const LidarPoint& p : scan.points) span_s = std::max(span_s, p.offset_time_s);
+  const int64_t end_ns = stamp_ns + static_cast<int64_t>(std::llround(span_s * 1e9));
+  Push(kLidar, stamp_ns, end_ns, io::BagRecord{std::move(scan)});
 }
 
-void PushSource::Push(Stream stream, int64_t stamp_ns, io::BagRecord record) {
+void PushSource::Push(Stream stream, int64_t stamp_ns, int64_t passed_ns, io::BagRecord record) {
   const int64_t now_ns = clock_->NowNs();
   std::unique_lock<std::mutex> lock(mutex_);
   if (closed_ || interrupted_) return;
@@ -68,7 +73,7 @@ void PushSource::Push(Stream stream, int64_t stamp_ns, io::BagRecord record) {
   }
   if (stream == kLidar) ++buffered_scans_;
   has_pushed_[stream] = true;
-  last_pushed_ns_[stream] = std::max(last_pushed_ns_[stream], stamp_ns);
+  passed_ns_[stream] = std::max(passed_ns_[stream], passed_ns);
   Entry entry;
   entry.record = std::move(record);
   entry.push_clock_ns = now_ns;
@@ -108,7 +113,7 @@ bool PushSource::Releasable(int64_t now_ns) const {
 bool PushSource::OthersPassed(const Key& key) const {
   for (int s = 0; s < kNumStreams; ++s) {
     if (s == std::get<1>(key)) continue;
-    if (!has_pushed_[s] || last_pushed_ns_[s] < std::get<0>(key)) return false;
+    if (!has_pushed_[s] || passed_ns_[s] < std::get<0>(key)) return false;
   }
   return true;
 }

@@ -5,8 +5,13 @@
 // Two streams, IMU and LiDAR, arrive in any interleaving (two subscriptions,
 // two TCP connections). A pushed record waits in a buffer; the buffer's
 // first record in (stamp, IMU before scan, push order) is released when
-//   - the other stream has pushed a record stamped at or after it (each
-//     stream's stamps are non-decreasing, so nothing earlier can come), or
+//   - the other stream has passed its stamp: nothing earlier can come from
+//     it. Each stream's stamps are non-decreasing; the IMU stream has passed
+//     its last stamp, the LiDAR stream the end of its last scan (stamp + the
+//     largest point offset: the next scan starts after it, an overlapping
+//     scan is dropped by the odometry offline and live alike). So an IMU
+//     sample within a scan is released as soon as that scan arrives, not
+//     one scan period later; or
 //   - it has waited max_wait_ms on the clock (the other stream is late or
 //     silent; a bounded wait), or
 //   - the buffer holds max_buffered_records records, or Close() was called.
@@ -103,7 +108,8 @@ class PushSource : public RecordSource {
   };
 
   PushSource() = default;
-  void Push(Stream stream, int64_t stamp_ns, io::BagRecord record);
+  // `passed_ns`: the stream will push nothing stamped before it.
+  void Push(Stream stream, int64_t stamp_ns, int64_t passed_ns, io::BagRecord record);
   // Blocks (lock held) until the first record may be released; false at the
   // end (closed and empty) or after Interrupt().
   bool WaitReleasable(std::unique_lock<std::mutex>* lock);
@@ -120,7 +126,7 @@ class PushSource : public RecordSource {
   uint64_t next_seq_ = 0;
   int buffered_scans_ = 0;
   bool has_pushed_[kNumStreams] = {false, false};
-  int64_t last_pushed_ns_[kNumStreams] = {0, 0};  // latest stamp per stream
+  int64_t passed_ns_[kNumStreams] = {0, 0};  // per stream: nothing earlier will come
   bool has_released_ = false;
   Key last_released_{0, 0, 0};
   bool closed_ = false;
