@@ -8,7 +8,10 @@
 // (none dropped), at the same stamps, within 1 mm. The node puts the two
 // streams back in stamp order (live::PushSource), so the estimator sees
 // exactly the replay's record sequence; a reordered record or a dropped
-// scan changes the estimate or the stamps and fails the test.
+// scan changes the estimate or the stamps and fails the test (with
+// --max_wait_ms 0, i.e. arrival order, every scan comes late and is dropped).
+// The node's waits are generous (4 s) so that a test machine busy with other
+// tests does not release records early.
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -244,8 +247,8 @@ TEST(RosNodeTest, OdometryOverRosmasterEqualsOfflineReplay) {
          "--key_file", key_path, "--udp_mode", "unicast", "--interface_address", "127.0.0.1",
          "--port", std::to_string(FreePort(SOCK_DGRAM)), "--peers",
          "uav2=127.0.0.1:" + std::to_string(FreePort(SOCK_DGRAM)), "--output_dir",
-         root + "/node", "--idle_timeout_s", "2", "--max_scan_backlog_s", "30",
-         "--max_queued_scans", "1000", "--max_buffered_scans", "1000", "--max_wait_ms", "2000"},
+         root + "/node", "--idle_timeout_s", "4", "--max_scan_backlog_s", "30",
+         "--max_queued_scans", "1000", "--max_buffered_scans", "1000", "--max_wait_ms", "4000"},
         root + "/node.log");
     ASSERT_TRUE(node_process.started());
     Child publisher({SWARMLIO_BAG_PUBLISHER, "--bag", root + "/sim/uav1.bag", "--lidar_delay_s",
