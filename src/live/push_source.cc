@@ -46,22 +46,12 @@ void PushSource::PushScan(LidarScan scan) {
 }
 
 void PushSource::Push(Stream stream, int64_t stamp_ns, int64_t passed_ns, io::BagRecord record) {
-  const int64_t now_ns = clock_->NowNs();
   std::unique_lock<std::mutex> lock(mutex_);
   if (closed_ || interrupted_) return;
   if (stream == kImu) {
     ++stats_.imu_pushed;
   } else {
     ++stats_.scans_pushed;
-  }
-  if (has_released_ && std::make_tuple(stamp_ns, static_cast<int>(stream)) <
-                           std::make_tuple(std::get<0>(last_released_), std::get<1>(last_released_))) {
-    ++(stream == kImu ? stats_.imu_late : stats_.scans_late);
-    return;
-  }
-  if (stream == kLidar && buffered_scans_ >= options_.max_buffered_scans) {
-    ++stats_.scans_dropped_full;
-    return;
   }
   if (stream == kImu && buffer_.size() >= static_cast<size_t>(options_.max_buffered_records)) {
     ++stats_.imu_push_waits;
@@ -71,12 +61,22 @@ void PushSource::Push(Stream stream, int64_t stamp_ns, int64_t passed_ns, io::Ba
     });
     if (closed_ || interrupted_) return;
   }
+  // After the wait: a full buffer may have released later records meanwhile.
+  if (has_released_ && std::make_tuple(stamp_ns, static_cast<int>(stream)) <
+                           std::make_tuple(std::get<0>(last_released_), std::get<1>(last_released_))) {
+    ++(stream == kImu ? stats_.imu_late : stats_.scans_late);
+    return;
+  }
+  if (stream == kLidar && buffered_scans_ >= options_.max_buffered_scans) {
+    ++stats_.scans_dropped_full;
+    return;
+  }
   if (stream == kLidar) ++buffered_scans_;
   has_pushed_[stream] = true;
   passed_ns_[stream] = std::max(passed_ns_[stream], passed_ns);
   Entry entry;
   entry.record = std::move(record);
-  entry.push_clock_ns = now_ns;
+  entry.push_clock_ns = clock_->NowNs();  // the bounded wait starts now
   buffer_.emplace(Key{stamp_ns, static_cast<int>(stream), next_seq_++}, std::move(entry));
   lock.unlock();
   changed_.notify_all();
