@@ -189,7 +189,7 @@ TEST(PushSource, LiveDroneFedByPushesReproducesTheOfflineReplay) {
   swarmlio::testing::TempDir dir;
   replay::SwarmManifest manifest;
   ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
-      std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "push", 8.0,
+      std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "push", 6.0,
       dir.path(), &manifest));
   manifest.drones.resize(1);
   const replay::DroneInput& drone = manifest.drones[0];
