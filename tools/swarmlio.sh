@@ -30,6 +30,8 @@ PACKAGES=(
   libeigen3-dev libceres-dev libsuitesparse-dev libgflags-dev libgoogle-glog-dev
   libgtest-dev libgmock-dev libbenchmark-dev libyaml-cpp-dev libpcl-dev
   librosbag-storage-dev libsensor-msgs-dev libgeometry-msgs-dev
+  libroscpp-dev libtopic-tools-dev libnav-msgs-dev libvisualization-msgs-dev libtf2-msgs-dev
+  python3-rosmaster
   libnanoflann-dev robin-map-dev libtbb-dev
   libcairo2-dev
   libsodium-dev
@@ -124,9 +126,9 @@ fuzz_stage() {
 # per-drone workers (Simulator::Run with num_threads = 2) in-process and
 # through the swarmlio_sim tool, and the live process (swarmlio_live: input,
 # estimator and network threads per drone, three drones over UDP in one test;
-# docs/online.md) with its queue and recording tests. No other library code
-# starts threads.
-TSAN_TESTS='^(Scenario\.ParsesAndSimulatesDeterministically|Imperfections\.RealisticRunLosesAndJittersImuSamples|sim\.same_seed_gives_identical_bytes(_realistic)?|(BoundedQueue|PacketLog|RecordedPacketTransport|ImuRateOdometry|LiveSwarmTest|LiveDropTest|LiveDrone)\.[A-Za-z]+)$'
+# docs/online.md) with its queue, push-input and recording tests. No other
+# library code starts threads.
+TSAN_TESTS='^(Scenario\.ParsesAndSimulatesDeterministically|Imperfections\.RealisticRunLosesAndJittersImuSamples|sim\.same_seed_gives_identical_bytes(_realistic)?|(BoundedQueue|PacketLog|RecordedPacketTransport|ImuRateOdometry|PushSource|LiveSwarmTest|LiveDropTest|LiveDrone)\.[A-Za-z]+)$'
 tsan_stage() {
   log "thread sanitizer stage: -fsanitize=thread on the threaded simulator and live tests"
   # libpcl_io loads Debian's uninstrumented libOpenNI2, whose static destructors

@@ -20,19 +20,20 @@
 #include "src/io/point_time_check.h"
 #include "src/io/pointcloud2_codec.h"
 #include "src/io/pose_codec.h"
+#include "src/io/record_checks.h"
 #include "swarmlio/common/check.h"
 
 namespace swarmlio::io {
 namespace {
 
+using internal::AllFinite;
+using internal::DropNonFinitePoints;
+using internal::IsCustomMsgType;
 using internal::kLivoxCustomMsgMd5;
 
 constexpr char kImuType[] = "sensor_msgs/Imu";
 constexpr char kPointCloud2Type[] = "sensor_msgs/PointCloud2";
 constexpr char kPoseStampedType[] = "geometry_msgs/PoseStamped";
-// The Livox drivers 1 and 2 use the same CustomMsg layout (and MD5).
-constexpr std::array<const char*, 2> kCustomMsgTypes = {"livox_ros_driver/CustomMsg",
-                                                        "livox_ros_driver2/CustomMsg"};
 // LiDAR messages whose bag times give the scan period.
 constexpr size_t kScanPeriodSamples = 1001;
 
@@ -63,13 +64,6 @@ const char* AcceptedTypes(StreamKind kind) {
   return "?";
 }
 
-bool IsCustomMsgType(const std::string& datatype) {
-  for (const char* custom : kCustomMsgTypes) {
-    if (datatype == custom) return true;
-  }
-  return false;
-}
-
 bool TypeMatches(StreamKind kind, const std::string& datatype) {
   switch (kind) {
     case StreamKind::kImu:
@@ -80,28 +74,6 @@ bool TypeMatches(StreamKind kind, const std::string& datatype) {
       return datatype == kPoseStampedType || datatype == internal::kNavOdometryDataType;
   }
   return false;
-}
-
-bool AllFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
-
-bool PointFinite(const LidarPoint& p) {
-  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) &&
-         std::isfinite(p.offset_time_s);
-}
-
-// Removes non-finite points; returns how many were removed.
-int64_t DropNonFinitePoints(LidarScan* scan) {
-  std::vector<LidarPoint>& points = scan->points;
-  const size_t before = points.size();
-  size_t kept = 0;
-  for (size_t i = 0; i < before; ++i) {
-    if (PointFinite(points[i])) {
-      if (kept != i) points[kept] = points[i];
-      ++kept;
-    }
-  }
-  points.resize(kept);
-  return static_cast<int64_t>(before - kept);
 }
 
 }  // namespace

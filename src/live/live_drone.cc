@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "swarmlio/io/bag_reader.h"
+#include "swarmlio/live/bag_playback_source.h"
 #include "swarmlio/live/bounded_queue.h"
 #include "swarmlio/live/imu_rate_odometry.h"
 #include "swarmlio/live/recording_transport.h"
@@ -22,8 +23,6 @@
 
 namespace swarmlio::live {
 namespace {
-
-constexpr int64_t kMaxSleepNs = 5'000'000;  // the input thread re-checks Stop() this often
 
 // One bag record on its way to the estimator. A scan dropped at the input
 // keeps only its stamp (memory stays bounded while the estimator is behind).
@@ -46,9 +45,8 @@ struct LiveDrone::Impl {
   LiveSetup setup;
   LiveOptions options;
   LiveSink* sink = &g_null_sink;
-  std::unique_ptr<io::BagReader> reader;
-  io::BagRecord first;
-  bool has_first = false;
+  std::unique_ptr<RecordSource> owned_source;  // the bag playback when setup.source is null
+  RecordSource* source = nullptr;
   std::unique_ptr<swarm::DroneEstimator> estimator;
   std::unique_ptr<ImuRateOdometry> imu_rate;
   net::PacketCodec codec;
@@ -110,23 +108,19 @@ Status LiveDrone::Create(const LiveSetup& setup, const LiveOptions& options,
   im.setup = setup;
   im.options = options;
   if (setup.sink != nullptr) im.sink = setup.sink;
-  Status status = io::BagReader::Open(setup.drone.bag_path, setup.drone.bag, &im.reader);
-  if (!status.ok()) return status.WithContext(name);
-  status = im.reader->Next(&im.first, &im.has_first);
-  if (!status.ok()) return status.WithContext(name);
-  if (options.start_offset_s > 0.0 && im.has_first) {
-    // A late join or a restart mid-flight: the playback starts later in the log.
-    const int64_t start_ns =
-        im.first.stamp_ns() + static_cast<int64_t>(std::llround(options.start_offset_s * 1e9));
-    while (im.has_first && im.first.stamp_ns() < start_ns) {
-      status = im.reader->Next(&im.first, &im.has_first);
-      if (!status.ok()) return status.WithContext(name);
+  Status status;
+  if (setup.source != nullptr) {
+    if (options.rate != 1.0 || options.start_offset_s != 0.0) {
+      return Status::InvalidArgument(name + ": a pushed input runs at the sensors' pace: rate must "
+                                     "be 1 and start_offset_s 0");
     }
-    if (!im.has_first) {
-      return Status::InvalidArgument(name + ": start_offset_s " +
-                                     std::to_string(options.start_offset_s) +
-                                     " s is beyond the end of the log");
-    }
+    im.source = setup.source;
+  } else {
+    std::unique_ptr<BagPlaybackSource> bag;
+    SWARMLIO_RETURN_IF_ERROR(
+        BagPlaybackSource::Open(setup.drone, options.start_offset_s, setup.clock, &bag));
+    im.owned_source = std::move(bag);
+    im.source = im.owned_source.get();
   }
   swarm::DroneEstimatorOptions estimator_options;
   estimator_options.odometry = setup.drone.odometry;
@@ -142,7 +136,7 @@ Status LiveDrone::Create(const LiveSetup& setup, const LiveOptions& options,
   if (!setup.packet_log_path.empty()) {
     net::PacketLogHeader header;
     header.self_id = setup.drone_id;
-    header.sensor_start_ns = im.has_first ? im.first.stamp_ns() : 0;
+    header.sensor_start_ns = im.source->known_start_ns();
     status = net::PacketLogWriter::Open(setup.packet_log_path, header, &log);
     if (!status.ok()) return status.WithContext(name);
   }
@@ -165,6 +159,7 @@ const SensorTimeMapping& LiveDrone::mapping() const { return impl_->mapping; }
 
 void LiveDrone::Stop() {
   impl_->stop = true;
+  impl_->source->Interrupt();
   impl_->input_queue->Close();
   {
     std::lock_guard<std::mutex> lock(impl_->watermark_mutex);
@@ -176,9 +171,12 @@ Status LiveDrone::Run() {
   Impl& im = *impl_;
   if (im.ran) return Status::FailedPrecondition(im.setup.drone.name + ": Run() called twice");
   im.ran = true;
+  SourceStart start;
+  bool has_record = false;
+  im.input_error = im.source->Start(&start, &has_record).WithContext(im.setup.drone.name);
   im.mapping.rate = im.options.rate;
-  im.mapping.sensor_start_ns = im.has_first ? im.first.stamp_ns() : 0;
-  im.mapping.clock_start_ns = im.setup.clock->NowNs();
+  im.mapping.sensor_start_ns = start.sensor_ns;
+  im.mapping.clock_start_ns = start.clock_ns;
   im.watermark_ns = im.mapping.sensor_start_ns - 1;
   im.stats.sensor_start_ns = im.mapping.sensor_start_ns;
   im.stats.clock_start_ns = im.mapping.clock_start_ns;
@@ -198,15 +196,16 @@ Status LiveDrone::Run() {
 }
 
 void LiveDrone::Impl::InputLoop() {
-  io::BagRecord record = std::move(first);
-  bool has = has_first;
+  io::BagRecord record;
+  bool has = input_error.ok();
   while (has && !stop) {
-    const int64_t stamp_ns = record.stamp_ns();
-    const int64_t due_ns = mapping.ToClockNs(stamp_ns);
-    for (int64_t now = setup.clock->NowNs(); now < due_ns && !stop; now = setup.clock->NowNs()) {
-      setup.clock->SleepForNs(std::min(due_ns - now, kMaxSleepNs));
+    const Status status = source->Next(mapping, &record, &has);
+    if (!status.ok()) {
+      input_error = status.WithContext(setup.drone.name);
+      break;
     }
-    if (stop) break;
+    if (!has || stop) break;
+    const int64_t stamp_ns = record.stamp_ns();
     InputItem item;
     item.stamp_ns = stamp_ns;
     if (record.scan() != nullptr) {
@@ -226,11 +225,6 @@ void LiveDrone::Impl::InputLoop() {
     stats.sensor_end_ns = stamp_ns;
     if (input_queue->size() >= input_queue->capacity()) ++stats.input_stalls;
     if (!input_queue->Push(std::move(item))) break;  // closed by Stop()
-    const Status status = reader->Next(&record, &has);
-    if (!status.ok()) {
-      input_error = status.WithContext(setup.drone.name);
-      break;
-    }
   }
   input_queue->Close();
 }

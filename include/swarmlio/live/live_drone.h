@@ -1,11 +1,14 @@
 // LiveDrone: one drone of the live swarm in real time (docs/online.md). It
-// plays the drone's bag at `rate` x real time against an injected Clock,
-// runs its swarm::DroneEstimator and talks to the teammates through a real
-// net::Transport (UdpTransport), with three threads:
+// takes the drone's sensor records from a RecordSource (record_source.h):
+// its bag played at `rate` x real time against an injected Clock
+// (BagPlaybackSource, the default), or records pushed by a driver such as the
+// ROS node (PushSource); runs its swarm::DroneEstimator and talks to the
+// teammates through a real net::Transport (UdpTransport), with three threads:
 //
-//   input      reads the bag and releases each record at its time
-//              (SensorTimeMapping); bounded queue to the estimator; a scan
-//              beyond max_queued_scans waiting is dropped (IMU never);
+//   input      takes each record from the source when it is due (bag:
+//              SensorTimeMapping) or released (push: stamp order); bounded
+//              queue to the estimator; a scan beyond max_queued_scans
+//              waiting is dropped (IMU never);
 //   estimator  consumes records in stamp order; before a record at stamp s
 //              it waits until the network thread has polled up to s and
 //              delivers the received messages with arrival <= s (exactly the
@@ -29,6 +32,7 @@
 #include "swarmlio/live/clock.h"
 #include "swarmlio/live/live_options.h"
 #include "swarmlio/live/live_sink.h"
+#include "swarmlio/live/record_source.h"
 #include "swarmlio/net/message_channel.h"
 #include "swarmlio/net/swarm_key.h"
 #include "swarmlio/net/transport.h"
@@ -38,17 +42,20 @@
 namespace swarmlio::live {
 
 struct LiveSetup {
-  replay::DroneInput drone;  // bag, sensors, estimator options
+  replay::DroneInput drone;  // bag (unless `source`), sensors, estimator options
   int drone_id = 0;          // swarm id (index in the manifest; the same on every drone)
   net::SwarmKey key;         // the swarm's pre-shared key
   net::Transport* transport = nullptr;  // not owned; used by the network thread only
   const Clock* clock = nullptr;         // not owned
   LiveSink* sink = nullptr;             // not owned; may be null
   std::string packet_log_path;          // received datagrams; "" = not recorded
+  RecordSource* source = nullptr;       // not owned; null: the drone's bag played back
+                                        // (BagPlaybackSource); a pushed source needs
+                                        // rate 1 and start_offset_s 0
 };
 
 struct LiveStats {
-  int64_t records_played = 0;        // released by the input thread
+  int64_t records_played = 0;        // taken from the source by the input thread
   int64_t imu_samples = 0;
   int64_t scans_played = 0;
   int64_t scans_processed = 0;       // estimator outputs
@@ -76,17 +83,20 @@ struct LiveStats {
 
 class LiveDrone {
  public:
-  /// Opens the bag (reads its first record), creates the estimator, codec
-  /// and packet log. Errors name the drone, the option or the file.
+  /// Opens the bag (reads its first record) unless setup.source is given,
+  /// creates the estimator, codec and packet log. Errors name the drone, the
+  /// option or the file.
   static Status Create(const LiveSetup& setup, const LiveOptions& options,
                        std::unique_ptr<LiveDrone>* drone);
   ~LiveDrone();
   LiveDrone(const LiveDrone&) = delete;
   LiveDrone& operator=(const LiveDrone&) = delete;
 
-  /// Plays the whole bag (or until Stop()), then flushes the estimator and
-  /// joins the threads. Returns the first error (bag read, transport, packet
-  /// log); what was processed until then is kept. Call once.
+  /// Plays the whole bag / takes records until the source ends (or until
+  /// Stop()), then flushes the estimator and joins the threads. Blocks first
+  /// until the source has its first record (the sensor time line's start).
+  /// Returns the first error (bag read, transport, packet log); what was
+  /// processed until then is kept. Call once.
   Status Run();
   /// Asks Run() to finish early (any thread, e.g. a signal watcher).
   void Stop();

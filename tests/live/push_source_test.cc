@@ -1,0 +1,271 @@
+// PushSource (the ROS node's input): whatever the interleaving of the IMU and
+// LiDAR pushes, records come out in the bag reader's order (stamp, IMU
+// first); the bounded wait releases a record whose other stream is silent
+// and a record stamped before a released one is dropped as late; scans are
+// dropped whole when too many wait, IMU pushes block instead. End to end: a
+// LiveDrone fed by a PushSource, its scans pushed late as a driver publishes
+// them, reproduces the offline replay of the same bag bit for bit.
+#include "swarmlio/live/push_source.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <thread>
+#include <tuple>
+#include <vector>
+
+#include "swarmlio/io/bag_reader.h"
+#include "swarmlio/live/live_drone.h"
+#include "swarmlio/live/steady_clock.h"
+#include "swarmlio/net/simulated_network.h"
+#include "swarmlio/replay/swarm_replay.h"
+#include "test_utils/simulated_swarm.h"
+#include "test_utils/temp_dir.h"
+
+namespace swarmlio::live {
+namespace {
+
+/// Time that moves only when the test says so.
+class ManualClock : public Clock {
+ public:
+  int64_t NowNs() const override { return now_ns_.load(); }
+  void SleepForNs(int64_t duration_ns) const override {
+    std::this_thread::sleep_for(std::chrono::nanoseconds(std::min<int64_t>(duration_ns, 1'000'000)));
+  }
+  void Advance(int64_t ns) { now_ns_ += ns; }
+
+ private:
+  std::atomic<int64_t> now_ns_{1'000'000'000};
+};
+
+ImuSample Imu(int64_t stamp_ns) {
+  ImuSample imu;
+  imu.stamp_ns = stamp_ns;
+  return imu;
+}
+
+LidarScan Scan(int64_t stamp_ns) {
+  LidarScan scan;
+  scan.stamp_ns = stamp_ns;
+  scan.points.resize(1);
+  return scan;
+}
+
+// (stamp, 0 = IMU / 1 = scan) of every record until the end.
+std::vector<std::tuple<int64_t, int>> Drain(PushSource* source) {
+  std::vector<std::tuple<int64_t, int>> out;
+  SourceStart start;
+  bool has = false;
+  if (!source->Start(&start, &has).ok() || !has) return out;
+  const SensorTimeMapping mapping;
+  io::BagRecord record;
+  while (source->Next(mapping, &record, &has).ok() && has) {
+    out.emplace_back(record.stamp_ns(), record.scan() != nullptr ? 1 : 0);
+  }
+  return out;
+}
+
+TEST(PushSource, StampOrderWhateverTheInterleaving) {
+  ManualClock clock;  // never advances: no record is released by the timeout
+  PushSourceOptions options;
+  options.max_buffered_scans = 1000;  // a consumer starved by the scheduler drops nothing
+  std::unique_ptr<PushSource> source;
+  ASSERT_TRUE(PushSource::Create(options, &clock, &source).ok());
+  constexpr int kImu = 400;       // 2 s at 200 Hz
+  constexpr int64_t kImuPeriodNs = 5'000'000;
+  constexpr int64_t kScanPeriodNs = 100'000'000;
+  constexpr int64_t kT0 = 7'000'000'000;
+  std::atomic<int64_t> imu_pushed_until{0};
+  std::vector<std::tuple<int64_t, int>> released;
+  std::thread consumer([&] { released = Drain(source.get()); });
+  std::thread imu([&] {
+    for (int i = 0; i < kImu; ++i) {
+      source->PushImu(Imu(kT0 + i * kImuPeriodNs));
+      imu_pushed_until = kT0 + i * kImuPeriodNs;
+      if (i % 7 == 0) std::this_thread::yield();
+    }
+  });
+  std::thread lidar([&] {
+    // A scan stamped at its start is published at its end: after the IMU
+    // samples over it (and, racing, sometimes before a few of them).
+    for (int64_t s = kT0; s < kT0 + kImu * kImuPeriodNs - kScanPeriodNs; s += kScanPeriodNs) {
+      while (imu_pushed_until.load() < s + kScanPeriodNs - 3 * kImuPeriodNs) {
+        std::this_thread::yield();
+      }
+      source->PushScan(Scan(s));
+    }
+  });
+  imu.join();
+  lidar.join();
+  source->Close();
+  consumer.join();
+
+  std::vector<std::tuple<int64_t, int>> expected;
+  for (int i = 0; i < kImu; ++i) expected.emplace_back(kT0 + i * kImuPeriodNs, 0);
+  for (int64_t s = kT0; s < kT0 + kImu * kImuPeriodNs - kScanPeriodNs; s += kScanPeriodNs) {
+    expected.emplace_back(s, 1);
+  }
+  std::sort(expected.begin(), expected.end());  // stamp, then IMU (0) before scan (1)
+  EXPECT_EQ(released, expected);
+  const PushSourceStats st = source->stats();
+  EXPECT_EQ(st.released, static_cast<int64_t>(expected.size()));
+  EXPECT_EQ(st.released_by_timeout, 0);
+  EXPECT_EQ(st.imu_late + st.scans_late + st.scans_dropped_full, 0);
+}
+
+TEST(PushSource, BoundedWaitThenLateRecordsAreDropped) {
+  ManualClock clock;
+  PushSourceOptions options;
+  options.max_wait_ms = 100.0;
+  std::unique_ptr<PushSource> source;
+  ASSERT_TRUE(PushSource::Create(options, &clock, &source).ok());
+  std::atomic<int> released{0};
+  std::thread consumer([&] {
+    SourceStart start;
+    bool has = false;
+    if (!source->Start(&start, &has).ok() || !has) return;
+    io::BagRecord record;
+    while (source->Next(SensorTimeMapping(), &record, &has).ok() && has) ++released;
+  });
+  source->PushImu(Imu(2'000'000'000));  // the LiDAR stream is silent
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  EXPECT_EQ(released.load(), 0);  // waits for the LiDAR stream to pass its stamp
+  clock.Advance(100'000'000);     // max_wait_ms later
+  for (int i = 0; i < 500 && released.load() == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_EQ(released.load(), 1);
+  source->PushScan(Scan(1'999'000'000));  // before the released IMU sample: late
+  source->PushImu(Imu(1'998'000'000));
+  source->Interrupt();
+  consumer.join();
+  const PushSourceStats st = source->stats();
+  EXPECT_EQ(st.released_by_timeout, 1);
+  EXPECT_EQ(st.scans_late, 1);
+  EXPECT_EQ(st.imu_late, 1);
+}
+
+TEST(PushSource, ScansDroppedWholeImuNeverDropped) {
+  ManualClock clock;
+  PushSourceOptions options;
+  options.max_buffered_scans = 2;
+  options.max_buffered_records = 16;
+  std::unique_ptr<PushSource> source;
+  ASSERT_TRUE(PushSource::Create(options, &clock, &source).ok());
+  for (int k = 0; k < 3; ++k) source->PushScan(Scan(1'000'000'000 + k));
+  EXPECT_EQ(source->stats().scans_dropped_full, 1);
+  constexpr int kImu = 40;  // more than the buffer holds: the pushes wait for the consumer
+  std::thread imu([&] {
+    for (int i = 0; i < kImu; ++i) source->PushImu(Imu(1'000'000'000 + 10 * i));
+  });
+  for (int i = 0; i < 5000 && source->stats().imu_push_waits == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_GT(source->stats().imu_push_waits, 0);  // blocked on the full buffer, not dropped
+  std::vector<std::tuple<int64_t, int>> released;
+  std::thread consumer([&] { released = Drain(source.get()); });
+  imu.join();
+  source->Close();
+  consumer.join();
+  int imu_out = 0, scans_out = 0;
+  for (const auto& r : released) ++(std::get<1>(r) == 0 ? imu_out : scans_out);
+  EXPECT_EQ(imu_out, kImu);
+  EXPECT_EQ(scans_out, 2);
+  EXPECT_TRUE(std::is_sorted(released.begin(), released.end()));
+}
+
+/// Keeps the scan outputs (estimator thread; read after Run()).
+class ScanSink : public LiveSink {
+ public:
+  void OnScan(const swarm::DroneOutput& output, const ScanLatency& /*latency*/) override {
+    scans.push_back(replay::ToScanRecord(output));
+  }
+  std::vector<replay::ScanRecord> scans;
+};
+
+TEST(PushSource, LiveDroneFedByPushesReproducesTheOfflineReplay) {
+  swarmlio::testing::TempDir dir;
+  replay::SwarmManifest manifest;
+  ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
+      std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "push", 6.0,
+      dir.path(), &manifest));
+  manifest.drones.resize(1);
+  const replay::DroneInput& drone = manifest.drones[0];
+  std::unique_ptr<replay::SwarmReplay> offline;
+  Status s = replay::SwarmReplay::Create(manifest, &offline);
+  ASSERT_TRUE(s.ok()) << s.message();
+  ASSERT_TRUE(offline->Run(replay::ReplayOptions()).ok());
+  const std::vector<replay::ScanRecord>& reference = offline->drone(0).scans();
+  ASSERT_GT(reference.size(), 30u);
+
+  SteadyClock clock;
+  PushSourceOptions push_options;
+  push_options.max_wait_ms = 60'000.0;  // a loaded machine never releases early
+  push_options.max_buffered_scans = 1000;
+  std::unique_ptr<PushSource> source;
+  ASSERT_TRUE(PushSource::Create(push_options, &clock, &source).ok());
+  std::unique_ptr<net::SimulatedNetwork> network;
+  ASSERT_TRUE(net::SimulatedNetwork::Create(net::NetworkOptions(), {0, 1}, &network).ok());
+  ScanSink sink;
+  LiveSetup setup;
+  setup.drone = drone;
+  setup.drone_id = 0;
+  setup.transport = network->Endpoint(0);
+  setup.clock = &clock;
+  setup.sink = &sink;
+  setup.source = source.get();
+  LiveOptions options;
+  options.max_queued_scans = 1000;   // pushed faster than real time: nothing dropped
+  options.max_scan_backlog_s = 60.0;
+  std::unique_ptr<LiveDrone> live;
+  s = LiveDrone::Create(setup, options, &live);
+  ASSERT_TRUE(s.ok()) << s.message();
+  Status run_status;
+  std::thread runner([&] { run_status = live->Run(); });
+
+  // The bag's records, each scan pushed only once the IMU has passed its
+  // stamp by 0.1 s (a driver publishing at the scan end), as fast as possible.
+  std::unique_ptr<io::BagReader> reader;
+  ASSERT_TRUE(io::BagReader::Open(drone.bag_path, drone.bag, &reader).ok());
+  std::vector<LidarScan> held;
+  io::BagRecord record;
+  bool has = false;
+  int64_t pushed_scans = 0;
+  while (reader->Next(&record, &has).ok() && has) {
+    if (const ImuSample* imu = record.imu()) {
+      source->PushImu(*imu);
+      while (!held.empty() && held.front().stamp_ns + 100'000'000 <= imu->stamp_ns) {
+        source->PushScan(std::move(held.front()));
+        held.erase(held.begin());
+        ++pushed_scans;
+      }
+    } else if (LidarScan* scan = std::get_if<LidarScan>(&record.data)) {
+      held.push_back(std::move(*scan));
+    }
+  }
+  for (LidarScan& scan : held) {
+    source->PushScan(std::move(scan));
+    ++pushed_scans;
+  }
+  source->Close();
+  runner.join();
+  ASSERT_TRUE(run_status.ok()) << run_status.message();
+  const PushSourceStats st = source->stats();
+  EXPECT_EQ(st.scans_pushed, pushed_scans);
+  EXPECT_EQ(st.released_by_timeout + st.imu_late + st.scans_late + st.scans_dropped_full, 0);
+  EXPECT_EQ(live->stats().scans_dropped_queue + live->stats().scans_dropped_backlog, 0);
+  ASSERT_EQ(sink.scans.size(), reference.size());
+  double max_dp = 0.0;
+  for (size_t i = 0; i < reference.size(); ++i) {
+    EXPECT_EQ(sink.scans[i].stamp_ns, reference[i].stamp_ns);
+    max_dp = std::max(max_dp, (sink.scans[i].state.p_b_in_G - reference[i].state.p_b_in_G).norm());
+  }
+  EXPECT_LE(max_dp, 1e-9);
+  std::printf("pushed live vs offline replay: %zu scans, max position difference %.3g m\n",
+              reference.size(), max_dp);
+}
+
+}  // namespace
+}  // namespace swarmlio::live
