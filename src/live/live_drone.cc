@@ -33,8 +33,7 @@ struct InputItem {
 };
 
 struct Outgoing {
-  int64_t stamp_ns = 0;
-  net::SwarmMessage message;
+  net::SwarmMessage message;  // sent stamped with the network thread's clock
 };
 
 LiveSink g_null_sink;
@@ -78,7 +77,7 @@ struct LiveDrone::Impl {
   void WaitForNetwork(int64_t stamp_ns);
   void Deliver(int64_t stamp_ns, std::deque<net::ReceivedMessage>* pending);
   void Collect(std::vector<swarm::DroneOutput>* outputs);
-  void QueueOutgoing(std::vector<net::SwarmMessage>* messages, int64_t stamp_ns);
+  void QueueOutgoing(std::vector<net::SwarmMessage>* messages);
   void Send(const Outgoing& out);
   void Warn(const Status& status);
   double AccelerationFactor() const {
@@ -268,14 +267,11 @@ void LiveDrone::Impl::Collect(std::vector<swarm::DroneOutput>* outputs) {
   }
 }
 
-void LiveDrone::Impl::QueueOutgoing(std::vector<net::SwarmMessage>* out, int64_t stamp_ns) {
+void LiveDrone::Impl::QueueOutgoing(std::vector<net::SwarmMessage>* out) {
   out->clear();
   estimator->PopMessages(out);
   for (net::SwarmMessage& m : *out) {
     Outgoing o;
-    o.stamp_ns = std::holds_alternative<net::EgoStateMessage>(m)
-                     ? std::get<net::EgoStateMessage>(m).stamp_ns
-                     : stamp_ns;
     o.message = std::move(m);
     if (!outbox->TryPush(std::move(o))) ++stats.outgoing_dropped_queue;
   }
@@ -286,7 +282,6 @@ void LiveDrone::Impl::EstimatorLoop() {
   std::vector<swarm::DroneOutput> outputs;
   std::vector<net::SwarmMessage> outgoing;
   const int64_t max_backlog_ns = static_cast<int64_t>(std::llround(options.max_scan_backlog_s * 1e9));
-  int64_t last_output_stamp_ns = mapping.sensor_start_ns;
   while (std::optional<InputItem> item = input_queue->Pop()) {
     if (stop) break;
     const int64_t s = item->stamp_ns;
@@ -316,13 +311,11 @@ void LiveDrone::Impl::EstimatorLoop() {
         Collect(&outputs);
       }
     }
-    if (!outputs.empty()) last_output_stamp_ns = outputs.back().ego.stamp_ns;
-    QueueOutgoing(&outgoing, last_output_stamp_ns);
+    QueueOutgoing(&outgoing);
   }
   Warn(estimator->Flush());
   Collect(&outputs);
-  if (!outputs.empty()) last_output_stamp_ns = outputs.back().ego.stamp_ns;
-  QueueOutgoing(&outgoing, last_output_stamp_ns);
+  QueueOutgoing(&outgoing);
   estimator_done = true;
 }
 
