@@ -1,5 +1,6 @@
 #include "swarmlio/replay/drone_runner.h"
 
+#include <cmath>
 #include <utility>
 
 namespace swarmlio::replay {
@@ -18,6 +19,20 @@ Status DroneRunner::Create(const DroneInput& input, int drone_id,
   if (!status.ok()) return status.WithContext(input.name);
   status = r->ReadNext();
   if (!status.ok()) return status.WithContext(input.name);
+  if (input.start_offset_s > 0.0 && r->has_next_) {
+    // A late join or a restart mid-flight: the drone starts later in its log.
+    const int64_t start_ns =
+        r->next_.stamp_ns() + static_cast<int64_t>(std::llround(input.start_offset_s * 1e9));
+    while (r->has_next_ && r->next_.stamp_ns() < start_ns) {
+      status = r->ReadNext();
+      if (!status.ok()) return status.WithContext(input.name);
+    }
+    if (!r->has_next_) {
+      return Status::InvalidArgument(input.name + ": start_offset_s " +
+                                     std::to_string(input.start_offset_s) +
+                                     " s is beyond the end of the log");
+    }
+  }
   *runner = std::move(r);
   return Status::Ok();
 }

@@ -28,6 +28,7 @@ struct DroneEntry {
   teammate::TeammateDetectorOptions teammate;
   swarm::SwarmOptions swarm;
   TrueClock true_clock;
+  double start_offset_s = 0.0;
   Eigen::Vector3d p_G_in_W_m = Eigen::Vector3d::Zero();
   std::vector<double> q_W_G_xyzw = {0.0, 0.0, 0.0, 1.0};
 
@@ -50,6 +51,10 @@ struct DroneEntry {
     v("teammate", teammate);
     v("swarm", swarm);
     v("true_clock", true_clock);
+    v("start_offset_s", start_offset_s,
+      FieldSpec::InRange(0.0, 1e6, "s",
+                         "skip the log's first seconds: the drone starts later (a late join or "
+                         "a restart in flight; pair with odometry: {initialization: in_flight})"));
     v("p_G_in_W_m", p_G_in_W_m,
       FieldSpec::InRange(-1e7, 1e7, "m", "origin of G in a common world frame (plots only)"));
     v("q_W_G_xyzw", q_W_G_xyzw,
@@ -139,6 +144,7 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     d.ground_truth_frame = e.ground_truth_frame;
     d.bag = e.bag_topics;
     d.true_clock = e.true_clock;
+    d.start_offset_s = e.start_offset_s;
     d.p_G_in_W_m = e.p_G_in_W_m;
     d.R_W_G = Eigen::Quaterniond(e.q_W_G_xyzw[3], e.q_W_G_xyzw[0], e.q_W_G_xyzw[1], e.q_W_G_xyzw[2])
                   .normalized()
