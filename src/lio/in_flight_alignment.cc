@@ -33,9 +33,11 @@ void Step(const Eigen::Vector3d& w, const Eigen::Vector3d& f, double dt, Integra
 Status DoubleIntegrateSpecificForce(const ImuSample& start, const std::vector<ImuSample>& samples,
                                     double acceleration_to_m_s2,
                                     const Eigen::Vector3d& gyro_bias_rad_s,
-                                    const std::vector<int64_t>& stamps_ns,
+                                    const std::vector<StampedPosition>& poses,
                                     std::vector<Eigen::Vector3d>* double_integrals) {
   double_integrals->clear();
+  std::vector<int64_t> stamps_ns;
+  for (const StampedPosition& p : poses) stamps_ns.push_back(p.stamp_ns);
   if (stamps_ns.empty()) return Status::Ok();
   if (samples.empty() || stamps_ns.front() <= start.stamp_ns ||
       stamps_ns.back() > samples.back().stamp_ns) {
@@ -61,6 +63,7 @@ Status DoubleIntegrateSpecificForce(const ImuSample& start, const std::vector<Im
       t = end;
       while (next < stamps_ns.size() && stamps_ns[next] == t) {
         double_integrals->push_back(s.p);
+        s.R = poses[next].q_G_b.normalized().toRotationMatrix();
         ++next;
       }
     }
@@ -89,11 +92,9 @@ Status AlignVelocityAndGravity(const ImuSample& start, const std::vector<ImuSamp
        << " s, need 0.2 s to tell gravity from velocity";
     return Status::FailedPrecondition(os.str());
   }
-  std::vector<int64_t> stamps;
-  for (const StampedPosition& p : positions) stamps.push_back(p.stamp_ns);
   std::vector<Eigen::Vector3d> D;
   SWARMLIO_RETURN_IF_ERROR(DoubleIntegrateSpecificForce(start, samples, acceleration_to_m_s2,
-                                                        gyro_bias_rad_s, stamps, &D));
+                                                        gyro_bias_rad_s, positions, &D));
   Eigen::MatrixXd A(3 * n, 6);
   Eigen::VectorXd b(3 * n);
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();

@@ -349,7 +349,10 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
   im.have_scan = true;
   ++counters_.scans_processed;
   if (im.probe.active) {
-    if (out.updated) im.probe.positions.push_back({out.stamp_ns, out.state.p_b_in_G});
+    if (out.updated) {
+      im.probe.positions.push_back({out.stamp_ns, out.state.p_b_in_G, out.state.q_G_b});
+      im.probe.gyro_bias = out.state.gyro_bias;
+    }
     return first_error;
   }
   if (hooks != nullptr) hooks->OnScanDone(out, x, P);

@@ -56,8 +56,10 @@ void Odometry::FinishInFlightPass() {
   internal::InFlightProbe& probe = im.probe;
   const ImuInitialization& start = probe.start;
   VelocityGravityAlignment fit;
+  // The pass's b_g (the filter estimated it from the LiDAR rotations) both
+  // integrates between the scans here and starts the next pass.
   Status status = AlignVelocityAndGravity(start.last_sample, probe.imu, start.acceleration_to_m_s2,
-                                          start.state.gyro_bias, probe.positions,
+                                          probe.gyro_bias, probe.positions,
                                           options_.in_flight.position_stddev_floor_m, &fit);
   ++counters_.in_flight_passes;
   const double g0 = options_.imu_init.nominal_gravity_m_s2;
@@ -99,6 +101,7 @@ void Odometry::FinishInFlightPass() {
   }
   ImuInitialization next = FromAlignment(start, fit, options_.in_flight,
                                          options_.imu_init.initial_accel_bias_stddev_m_s2);
+  next.state.gyro_bias = probe.gyro_bias;
   ++probe.pass;
   next.alignment_passes = probe.pass;
   const bool last = probe.pass >= options_.in_flight.passes;

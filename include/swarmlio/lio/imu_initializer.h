@@ -233,7 +233,7 @@ class ImuInitializer {
   struct InFlightCoarseSigmas {
     double velocity_m_s = 2.0;
     double gravity_m_s2 = 2.0;
-    double gyro_bias_rad_s = 0.01;
+    double gyro_bias_rad_s = 0.05;
   };
   Status InitializeInFlight(const InFlightCoarseSigmas& coarse, ImuInitialization* result) const;
 

@@ -26,7 +26,9 @@ struct InFlightInitOptions {
   int passes = 3;
   double coarse_velocity_stddev_m_s = 2.0;   // first pass: 1-sigma of v = 0 [m/s]
   double coarse_gravity_stddev_m_s2 = 3.0;   // first pass: 1-sigma of the coarse g [m/s^2]
-  double gyro_bias_stddev_rad_s = 0.01;      // prior of b_g = 0 (no static mean) [rad/s]
+  // Prior of b_g (0 in the first pass, then the pass's estimate): no static
+  // mean to take it from; the simulated Avia's built-in IMU has 0.07 rad/s [rad/s].
+  double gyro_bias_stddev_rad_s = 0.05;
   double position_stddev_floor_m = 0.01;     // least sigma of a fitted scan position [m]
   double velocity_stddev_floor_m_s = 0.02;   // added to the fitted velocity sigma [m/s]
   double gravity_stddev_floor_m_s2 = 0.02;   // added to the fitted gravity sigma [m/s^2]
