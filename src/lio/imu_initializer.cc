@@ -310,6 +310,7 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   ImuInitialization& r = *result;
   r = ImuInitialization();
   r.stamp_ns = window_.back().stamp_ns;
+  r.started_ns = r.stamp_ns;
   r.last_sample = window_.back();
   r.state = EgoState();
   r.state.gyro_bias = stats.mean_gyro;
@@ -395,6 +396,7 @@ Status ImuInitializer::InitializeInFlight(const InFlightCoarseSigmas& coarse,
   ImuInitialization& r = *result;
   r = ImuInitialization();
   r.stamp_ns = window_.back().stamp_ns;
+  r.started_ns = r.stamp_ns;
   r.last_sample = window_.back();
   r.state = EgoState();
   r.state.g_in_G = -factor * mean_in_G;

@@ -1,4 +1,5 @@
 // lio::Odometry's in-flight initialization (docs/imu.md section 1b).
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -131,6 +132,7 @@ void Odometry::FinishInFlightPass() {
   counters_.in_flight_passes = kept.in_flight_passes;
   counters_.in_flight_restarts = kept.in_flight_restarts;
   im.initialization = next;
+  im.initialization.started_ns = im.last_imu_stamp_ns;  // the newest input
   probe = internal::InFlightProbe();
   init_error_.clear();
 }

@@ -32,7 +32,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kLate = 2;  // uav3, the Avia
+constexpr int kLateJoiner = 2;  // uav3, the Avia
 constexpr double kStartOffsetS = 20.0;
 constexpr double kDurationS = 36.0;
 
@@ -82,24 +82,37 @@ class InFlightStartTest : public ::testing::Test {
     delete manifest_;
   }
 
-  static LateDroneFigures Run(lio::InitializationMode mode, double offset_s = kStartOffsetS) {
+  // The drone `late` starts `offset_s` into its log with `mode`; with
+  // `restart` it starts at rest and is restarted there instead (down 1 s).
+  static LateDroneFigures Run(lio::InitializationMode mode, double offset_s = kStartOffsetS,
+                              int late = kLateJoiner, bool restart = false) {
     SwarmManifest manifest = *manifest_;
-    DroneInput& late = manifest.drones[kLate];
-    late.start_offset_s = offset_s;
-    late.odometry.initialization = mode;
+    DroneInput& input = manifest.drones[late];
+    if (restart) {
+      input.restart_at_s = offset_s;
+      input.restart_initialization = mode;
+    } else {
+      input.start_offset_s = offset_s;
+      input.odometry.initialization = mode;
+    }
     std::unique_ptr<SwarmReplay> run;
     EXPECT_TRUE(SwarmReplay::Create(manifest, &run).ok());
     EXPECT_TRUE(run->Run(ReplayOptions()).ok());
     LateDroneFigures f;
-    const DroneRunner& d = run->drone(kLate);
+    const DroneRunner& d = run->drone(late);
     EXPECT_TRUE(d.odometry().initialized());
     const std::vector<PoseStamped>& gt = d.bag_ground_truth();  // T_G0_b, G0 at the log start
     const int64_t t0 = d.odometry().initialization().stamp_ns;
     EXPECT_FALSE(gt.empty());
     if (gt.empty()) return f;
-    f.init_delay_s = 1e-9 * static_cast<double>(t0 - gt.front().stamp_ns);
+    // Its start: its first record, or its return after the restart.
+    const int64_t start_ns =
+        gt.front().stamp_ns +
+        (restart ? static_cast<int64_t>(std::llround((offset_s + input.restart_down_s) * 1e9))
+                 : 0);
+    f.init_delay_s = 1e-9 * static_cast<double>(t0 - start_ns);
     if (!d.scans().empty()) {
-      f.first_output_s = 1e-9 * static_cast<double>(d.scans().front().stamp_ns - gt.front().stamp_ns);
+      f.first_output_s = 1e-9 * static_cast<double>(d.scans().front().stamp_ns - start_ns);
     }
     Eigen::Isometry3d T_G0_G;  // its true G: the IMU pose at the initialization
     EXPECT_TRUE(PoseAt(gt, t0, &T_G0_G));
@@ -117,7 +130,7 @@ class InFlightStartTest : public ::testing::Test {
       }
     }
     {
-      const DroneRunner& ref = run->drone(0);
+      const DroneRunner& ref = run->drone(late == 0 ? 1 : 0);
       double sse0 = 0.0;
       int n0 = 0;
       for (const ScanRecord& s : ref.scans()) {
@@ -139,22 +152,24 @@ class InFlightStartTest : public ::testing::Test {
     EXPECT_GT(n, 50);
     f.position_rmse_m = std::sqrt(sse / std::max(n, 1));
     // True T_Gi_Gj with the late drone's G.
-    const Eigen::Isometry3d T_W_Gj = manifest.drones[kLate].T_W_G() * T_G0_G;
+    const Eigen::Isometry3d T_W_Gj = manifest.drones[late].T_W_G() * T_G0_G;
     f.identified_after_s.assign(manifest.drones.size(), -1.0);
     f.end_error_m.assign(manifest.drones.size(), -1.0);
     f.end_error_deg.assign(manifest.drones.size(), -1.0);
     for (int i = 0; i < run->num_drones(); ++i) {
-      if (i == kLate) continue;
+      if (i == late) continue;
       const DroneRunner& observer = run->drone(i);
       for (const swarm::IdentificationEvent& e : observer.identifications()) {
-        if (e.drone_id == kLate && f.identified_after_s[i] < 0.0) {
-          f.identified_after_s[i] = 1e-9 * static_cast<double>(e.stamp_ns - gt.front().stamp_ns);
+        // (after a restart: the identification of its new session)
+        const double after_s = 1e-9 * static_cast<double>(e.stamp_ns - start_ns);
+        if (e.drone_id == late && f.identified_after_s[i] < 0.0 && after_s > 0.0) {
+          f.identified_after_s[i] = after_s;
         }
       }
       const Eigen::Isometry3d T_true = manifest.drones[i].T_W_G().inverse() * T_W_Gj;
       for (auto s = observer.scans().rbegin(); s != observer.scans().rend(); ++s) {
         const auto t = std::find_if(s->teammates.begin(), s->teammates.end(),
-                                    [](const TeammateRecord& r) { return r.drone_id == kLate; });
+                                    [&](const TeammateRecord& r) { return r.drone_id == late; });
         if (t == s->teammates.end()) continue;
         const Eigen::Isometry3d E = T_true.inverse() * t->T_Gi_Gj.T_Gi_Gj();
         f.end_error_m[i] = E.translation().norm();
@@ -172,13 +187,18 @@ class InFlightStartTest : public ::testing::Test {
 fs::path* InFlightStartTest::dir_ = nullptr;
 SwarmManifest* InFlightStartTest::manifest_ = nullptr;
 
-void Print(const char* label, const LateDroneFigures& f) {
-  std::printf("[ figures  ] %s: uav3 initialized %.2f s after its start (first output %.2f s; tilt %.3f deg, velocity "
-              "%.3f m/s off), position RMSE in its true G %.4f m (uav1 from rest: %.4f m); uav1 identified it after %.1f s (extrinsic at the end %.4f m / %.3f "
-              "deg), uav2 after %.1f s (%.4f m / %.3f deg)\n",
-              label, f.init_delay_s, f.first_output_s, f.init_tilt_deg, f.init_velocity_error_m_s, f.position_rmse_m,
-              f.reference_rmse_m, f.identified_after_s[0], f.end_error_m[0],
-              f.end_error_deg[0], f.identified_after_s[1], f.end_error_m[1], f.end_error_deg[1]);
+void Print(const char* label, const LateDroneFigures& f, int late = kLateJoiner) {
+  std::printf("[ figures  ] %s: uav%d initialized %.2f s after its start (first output %.2f s; "
+              "tilt %.3f deg, velocity %.3f m/s off), position RMSE in its true G %.4f m (a "
+              "teammate from rest: %.4f m)",
+              label, late + 1, f.init_delay_s, f.first_output_s, f.init_tilt_deg,
+              f.init_velocity_error_m_s, f.position_rmse_m, f.reference_rmse_m);
+  for (size_t i = 0; i < f.identified_after_s.size(); ++i) {
+    if (static_cast<int>(i) == late) continue;
+    std::printf("; uav%zu identified it after %.1f s (extrinsic at the end %.4f m / %.3f deg)",
+                i + 1, f.identified_after_s[i], f.end_error_m[i], f.end_error_deg[i]);
+  }
+  std::printf("\n");
 }
 
 TEST_F(InFlightStartTest, LateJoinerInitializedInFlightTracksAndIsIdentified) {
@@ -200,6 +220,27 @@ TEST_F(InFlightStartTest, LateJoinerInitializedInFlightTracksAndIsIdentified) {
     EXPECT_LE(in_flight.identified_after_s[i], 15.0) << i;
     EXPECT_LT(in_flight.end_error_m[i], 0.06) << i;
     EXPECT_LT(in_flight.end_error_deg[i], 1.0) << i;
+  }
+}
+
+// A restart mid-flight (the faults-B restart, offline): uav2 starts at rest,
+// is killed 18 s into its log (its estimator dropped, down 1 s) and starts a
+// new session in flight. Its teammates drop it and identify it again. Before
+// the fix, they also took each other's T_Gk_G2 of its OLD session (broadcast
+// until the sender hears the new session) as a graph identification: uav3's
+// extrinsic of it was then off by its motion since its first start (1.9 m /
+// 11 deg on the 60 s run, restart at 30 s), with either initialization.
+TEST_F(InFlightStartTest, RestartedDroneIsIdentifiedAgainWithItsNewG) {
+  constexpr int kRestarted = 1;  // uav2 (Mid-360)
+  const LateDroneFigures f =
+      Run(lio::InitializationMode::kInFlight, 18.0, kRestarted, /*restart=*/true);
+  Print("restart, in_flight", f, kRestarted);
+  EXPECT_LT(f.position_rmse_m, 0.03);
+  for (int i : {0, 2}) {
+    EXPECT_GE(f.identified_after_s[i], 0.0) << i;
+    EXPECT_LE(f.identified_after_s[i], 15.0) << i;
+    EXPECT_LT(f.end_error_m[i], 0.06) << i;
+    EXPECT_LT(f.end_error_deg[i], 1.0) << i;
   }
 }
 

@@ -170,6 +170,9 @@ struct ImuInitializerOptions {
 /// Result of a successful initialization.
 struct ImuInitialization {
   int64_t stamp_ns = 0;   // time of the state: the last sample of the window
+  // Sensor time at which the odometry started (its first outputs): stamp_ns
+  // at rest; in flight, the newest input when its last pass ended.
+  int64_t started_ns = 0;
   ImuSample last_sample;  // that sample, raw (the propagator's first input)
   EgoState state;         // R_G_b = I, p = v = 0, b_g, b_a = 0, g_in_G
   Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim> covariance =
