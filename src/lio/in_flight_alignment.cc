@@ -30,7 +30,8 @@ void Step(const Eigen::Vector3d& w, const Eigen::Vector3d& f, double dt, Integra
 
 }  // namespace
 
-Status DoubleIntegrateSpecificForce(const ImuSample& start, const std::vector<ImuSample>& samples,
+Status DoubleIntegrateSpecificForce(const ImuSample& start,
+                                    const std::vector<ImuSample>& samples,
                                     double acceleration_to_m_s2,
                                     const Eigen::Vector3d& gyro_bias_rad_s,
                                     const std::vector<StampedPosition>& poses,
@@ -55,10 +56,10 @@ Status DoubleIntegrateSpecificForce(const ImuSample& start, const std::vector<Im
       int64_t end = b.stamp_ns;
       if (next < stamps_ns.size() && stamps_ns[next] < end) end = stamps_ns[next];
       const double mid = 0.5 * Seconds((t - a.stamp_ns) + (end - a.stamp_ns)) / span;
-      const Eigen::Vector3d w = (1.0 - mid) * a.angular_velocity_rad_s +
-                                mid * b.angular_velocity_rad_s - gyro_bias_rad_s;
-      const Eigen::Vector3d f =
-          acceleration_to_m_s2 * ((1.0 - mid) * a.linear_acceleration + mid * b.linear_acceleration);
+      const Eigen::Vector3d w =
+          (1.0 - mid) * a.angular_velocity_rad_s + mid * b.angular_velocity_rad_s - gyro_bias_rad_s;
+      const Eigen::Vector3d f = acceleration_to_m_s2 *
+                                ((1.0 - mid) * a.linear_acceleration + mid * b.linear_acceleration);
       Step(w, f, Seconds(end - t), &s);
       t = end;
       while (next < stamps_ns.size() && stamps_ns[next] == t) {
@@ -76,10 +77,13 @@ Status DoubleIntegrateSpecificForce(const ImuSample& start, const std::vector<Im
   return Status::Ok();
 }
 
-Status AlignVelocityAndGravity(const ImuSample& start, const std::vector<ImuSample>& samples,
-                               double acceleration_to_m_s2, const Eigen::Vector3d& gyro_bias_rad_s,
+Status AlignVelocityAndGravity(const ImuSample& start,
+                               const std::vector<ImuSample>& samples,
+                               double acceleration_to_m_s2,
+                               const Eigen::Vector3d& gyro_bias_rad_s,
                                const std::vector<StampedPosition>& positions,
-                               double position_stddev_floor_m, VelocityGravityAlignment* result) {
+                               double position_stddev_floor_m,
+                               VelocityGravityAlignment* result) {
   const int n = static_cast<int>(positions.size());
   if (n < 3) {
     return Status::FailedPrecondition("in-flight alignment: " + std::to_string(n) +

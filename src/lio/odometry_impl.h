@@ -30,13 +30,13 @@ struct PendingScan {
 // without the hooks and without outputs; its scan positions fit v0 and g.
 struct InFlightProbe {
   bool active = false;
-  int pass = 0;                       // passes finished
-  ImuInitialization start;            // the current pass's initial state (at t0)
-  std::vector<ImuSample> imu;         // every sample after t0
-  std::vector<PendingScan> scans;     // every queued scan since t0
-  std::vector<StampedPosition> positions;  // the current pass's updated scans
+  int pass = 0;                                         // passes finished
+  ImuInitialization start;                              // the current pass's initial state (at t0)
+  std::vector<ImuSample> imu;                           // every sample after t0
+  std::vector<PendingScan> scans;                       // every queued scan since t0
+  std::vector<StampedPosition> positions;               // the current pass's updated scans
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // its last posterior b_g
-  OdometryCounters counters;          // the counters when the probe started
+  OdometryCounters counters;                            // the counters when the probe started
 };
 
 }  // namespace internal
@@ -51,7 +51,7 @@ struct Odometry::Impl {
   ScanAssociator associator;
   EsikfUpdate update;
   std::unique_ptr<internal::WindowSmoother> window;  // estimator: window
-  std::deque<ImuSample> imu_queue;  // after initialization, not yet propagated
+  std::deque<ImuSample> imu_queue;                   // after initialization, not yet propagated
   std::deque<internal::PendingScan> scan_queue;
   std::deque<internal::PendingScan> static_start_scans;  // before initialization (map seeding)
   internal::InFlightProbe probe;

@@ -16,7 +16,8 @@ using L = ErrorStateLayout;
 // (the fit assumed b_a = 0, so its g absorbed R_G_b b_a: equal errors).
 ImuInitialization FromAlignment(const ImuInitialization& coarse,
                                 const VelocityGravityAlignment& fit,
-                                const InFlightInitOptions& options, double accel_bias_sigma) {
+                                const InFlightInitOptions& options,
+                                double accel_bias_sigma) {
   ImuInitialization next = coarse;
   next.state.v_b_in_G = fit.v_b_in_G;
   next.state.g_in_G = fit.g_in_G;
@@ -142,9 +143,9 @@ Status Odometry::RestartFromInFlightStart(const ImuInitialization& start) {
   SWARMLIO_RETURN_IF_ERROR(im.propagator->Reset(start));
   im.map = LocalMap(options_.map);
   if (im.window != nullptr) {
-    SWARMLIO_RETURN_IF_ERROR(internal::WindowSmoother::Create(
-        options_.window, options_.propagation, options_.association, options_.update, &im.map,
-        &im.window));
+    SWARMLIO_RETURN_IF_ERROR(internal::WindowSmoother::Create(options_.window, options_.propagation,
+                                                              options_.association, options_.update,
+                                                              &im.map, &im.window));
   }
   im.imu_queue.assign(im.probe.imu.begin(), im.probe.imu.end());
   im.scan_queue.assign(im.probe.scans.begin(), im.probe.scans.end());

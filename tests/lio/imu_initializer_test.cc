@@ -366,11 +366,13 @@ TEST(ImuInitializer, InFlightStartRotatesTheSpecificForceIntoG) {
     ASSERT_TRUE(s.ok()) << s.message();
     const double t_end = 199 * 1e-9 * kPeriodNs;
     const Eigen::Vector3d g_true = R_W_b(t_end).transpose() * Eigen::Vector3d(0, 0, -kG);
-    EXPECT_LT((r.state.g_in_G - g_true).norm(), 0.01) << scale << ": " << r.state.g_in_G.transpose();
+    EXPECT_LT((r.state.g_in_G - g_true).norm(), 0.01)
+        << scale << ": " << r.state.g_in_G.transpose();
     EXPECT_TRUE(r.in_flight);
     EXPECT_EQ(r.acceleration_sign, scale < 0 ? -1 : 1);
-    EXPECT_EQ(r.acceleration_unit, std::abs(scale) < 0.5 ? AccelerationUnit::kStandardGravity
-                                                         : AccelerationUnit::kMetersPerSecondSquared);
+    const AccelerationUnit unit = std::abs(scale) < 0.5 ? AccelerationUnit::kStandardGravity
+                                                        : AccelerationUnit::kMetersPerSecondSquared;
+    EXPECT_EQ(r.acceleration_unit, unit);
     EXPECT_EQ(r.state.v_b_in_G, Eigen::Vector3d::Zero());
     EXPECT_EQ(r.state.gyro_bias, Eigen::Vector3d::Zero());
     // The coarse sigmas, and the g - b_a correlation of a static start.

@@ -33,8 +33,7 @@ struct Flight {
   }
   Eigen::Vector3d Position(double t) const {
     return v0_W * t + Eigen::Vector3d(0.75 * (t - std::sin(2.0 * t) / 2.0),
-                                      (std::cos(3.0 * t) - 1.0) / 9.0,
-                                      0.8 * (t - std::sin(t)));
+                                      (std::cos(3.0 * t) - 1.0) / 9.0, 0.8 * (t - std::sin(t)));
   }
   Eigen::Matrix3d R_W_b(double t) const { return R_W_b0 * so3::Exp(t * w_b); }
 
@@ -103,14 +102,13 @@ TEST(InFlightAlignment, TheCovarianceCoversTheErrorOfNoisyPositions) {
   const Eigen::Vector3d g_true = f.R_W_b0.transpose() * f.g_W;
   const Data d = Make(f, 1.5, 0.005);
   VelocityGravityAlignment a;
-  ASSERT_TRUE(AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(),
-                                      d.positions, 0.001, &a)
+  ASSERT_TRUE(AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), d.positions,
+                                      0.001, &a)
                   .ok());
   EXPECT_NEAR(a.rms_residual_m, 0.005, 0.002);
   for (int k = 0; k < 3; ++k) {
     EXPECT_LT(std::abs(a.v_b_in_G(k) - v_true(k)), 4.0 * std::sqrt(a.covariance(k, k))) << k;
-    EXPECT_LT(std::abs(a.g_in_G(k) - g_true(k)), 4.0 * std::sqrt(a.covariance(3 + k, 3 + k)))
-        << k;
+    EXPECT_LT(std::abs(a.g_in_G(k) - g_true(k)), 4.0 * std::sqrt(a.covariance(3 + k, 3 + k))) << k;
   }
   // About 0.2 deg of tilt from 5 mm positions over 1.5 s.
   EXPECT_LT(std::sqrt(a.covariance(3, 3)), 0.05);
@@ -145,24 +143,23 @@ TEST(InFlightAlignment, RefusesTooFewOrTooClosePositions) {
   Data d = Make(f, 1.5, 0.0);
   VelocityGravityAlignment a;
   std::vector<StampedPosition> two(d.positions.begin(), d.positions.begin() + 2);
-  EXPECT_EQ(AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), two, 0.01,
-                                    &a)
+  EXPECT_EQ(AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), two, 0.01, &a)
                 .code(),
             Status::Code::kFailedPrecondition);
   std::vector<StampedPosition> close(3, d.positions.front());
   close[1].stamp_ns += 1'000'000;
   close[2].stamp_ns += 2'000'000;
-  EXPECT_EQ(AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), close,
-                                    0.01, &a)
-                .code(),
-            Status::Code::kFailedPrecondition);
+  EXPECT_EQ(
+      AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), close, 0.01, &a)
+          .code(),
+      Status::Code::kFailedPrecondition);
   // A position after the last IMU sample cannot be integrated.
   std::vector<StampedPosition> late = d.positions;
   late.back().stamp_ns = d.samples.back().stamp_ns + 1;
-  EXPECT_EQ(AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), late, 0.01,
-                                    &a)
-                .code(),
-            Status::Code::kInvalidArgument);
+  EXPECT_EQ(
+      AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), late, 0.01, &a)
+          .code(),
+      Status::Code::kInvalidArgument);
 }
 
 }  // namespace

@@ -38,14 +38,13 @@ constexpr double kDurationS = 36.0;
 
 // T_G_b of a ground-truth track at `stamp_ns` (linear position, slerp).
 bool PoseAt(const std::vector<PoseStamped>& track, int64_t stamp_ns, Eigen::Isometry3d* T) {
-  const auto it = std::lower_bound(
-      track.begin(), track.end(), stamp_ns,
-      [](const PoseStamped& p, int64_t t) { return p.stamp_ns < t; });
+  const auto it = std::lower_bound(track.begin(), track.end(), stamp_ns,
+                                   [](const PoseStamped& p, int64_t t) { return p.stamp_ns < t; });
   if (it == track.begin() || it == track.end()) return false;
   const PoseStamped& a = *(it - 1);
   const PoseStamped& b = *it;
-  const double s = static_cast<double>(stamp_ns - a.stamp_ns) /
-                   static_cast<double>(b.stamp_ns - a.stamp_ns);
+  const double s =
+      static_cast<double>(stamp_ns - a.stamp_ns) / static_cast<double>(b.stamp_ns - a.stamp_ns);
   T->setIdentity();
   T->linear() = a.q_G_b.slerp(s, b.q_G_b).toRotationMatrix();
   T->translation() = (1.0 - s) * a.p_b_in_G + s * b.p_b_in_G;
@@ -60,7 +59,7 @@ struct LateDroneFigures {
   double init_velocity_error_m_s = 0.0;
   double reference_rmse_m = 0.0;  // uav1, from a static start, same measure
   // Per teammate (manifest order, the late drone's entry unused):
-  std::vector<double> identified_after_s;  // since its first record; < 0: never
+  std::vector<double> identified_after_s;          // since its first record; < 0: never
   std::vector<double> end_error_m, end_error_deg;  // the extrinsic at the end of the run
 };
 
@@ -84,8 +83,10 @@ class InFlightStartTest : public ::testing::Test {
 
   // The drone `late` starts `offset_s` into its log with `mode`; with
   // `restart` it starts at rest and is restarted there instead (down 1 s).
-  static LateDroneFigures Run(lio::InitializationMode mode, double offset_s = kStartOffsetS,
-                              int late = kLateJoiner, bool restart = false) {
+  static LateDroneFigures Run(lio::InitializationMode mode,
+                              double offset_s = kStartOffsetS,
+                              int late = kLateJoiner,
+                              bool restart = false) {
     SwarmManifest manifest = *manifest_;
     DroneInput& input = manifest.drones[late];
     if (restart) {
@@ -108,8 +109,7 @@ class InFlightStartTest : public ::testing::Test {
     // Its start: its first record, or its return after the restart.
     const int64_t start_ns =
         gt.front().stamp_ns +
-        (restart ? static_cast<int64_t>(std::llround((offset_s + input.restart_down_s) * 1e9))
-                 : 0);
+        (restart ? static_cast<int64_t>(std::llround((offset_s + input.restart_down_s) * 1e9)) : 0);
     f.init_delay_s = 1e-9 * static_cast<double>(t0 - start_ns);
     if (!d.scans().empty()) {
       f.first_output_s = 1e-9 * static_cast<double>(d.scans().front().stamp_ns - start_ns);
@@ -125,8 +125,7 @@ class InFlightStartTest : public ::testing::Test {
       if (PoseAt(gt, t0 - 5'000'000, &a) && PoseAt(gt, t0 + 5'000'000, &b)) {
         const Eigen::Vector3d v_true =
             T_G0_G.linear().transpose() * (b.translation() - a.translation()) / 0.01;
-        f.init_velocity_error_m_s =
-            (d.odometry().initialization().state.v_b_in_G - v_true).norm();
+        f.init_velocity_error_m_s = (d.odometry().initialization().state.v_b_in_G - v_true).norm();
       }
     }
     {
@@ -188,11 +187,12 @@ fs::path* InFlightStartTest::dir_ = nullptr;
 SwarmManifest* InFlightStartTest::manifest_ = nullptr;
 
 void Print(const char* label, const LateDroneFigures& f, int late = kLateJoiner) {
-  std::printf("[ figures  ] %s: uav%d initialized %.2f s after its start (first output %.2f s; "
-              "tilt %.3f deg, velocity %.3f m/s off), position RMSE in its true G %.4f m (a "
-              "teammate from rest: %.4f m)",
-              label, late + 1, f.init_delay_s, f.first_output_s, f.init_tilt_deg,
-              f.init_velocity_error_m_s, f.position_rmse_m, f.reference_rmse_m);
+  std::printf(
+      "[ figures  ] %s: uav%d initialized %.2f s after its start (first output %.2f s; "
+      "tilt %.3f deg, velocity %.3f m/s off), position RMSE in its true G %.4f m (a "
+      "teammate from rest: %.4f m)",
+      label, late + 1, f.init_delay_s, f.first_output_s, f.init_tilt_deg, f.init_velocity_error_m_s,
+      f.position_rmse_m, f.reference_rmse_m);
   for (size_t i = 0; i < f.identified_after_s.size(); ++i) {
     if (static_cast<int>(i) == late) continue;
     std::printf("; uav%zu identified it after %.1f s (extrinsic at the end %.4f m / %.3f deg)",

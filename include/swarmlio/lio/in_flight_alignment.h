@@ -52,7 +52,8 @@ struct VelocityGravityAlignment {
 /// rotation restarts from each pose's q_G_b there.
 /// acceleration_to_m_s2: the signed unit factor k. InvalidArgument on
 /// stamps outside the samples.
-Status DoubleIntegrateSpecificForce(const ImuSample& start, const std::vector<ImuSample>& samples,
+Status DoubleIntegrateSpecificForce(const ImuSample& start,
+                                    const std::vector<ImuSample>& samples,
                                     double acceleration_to_m_s2,
                                     const Eigen::Vector3d& gyro_bias_rad_s,
                                     const std::vector<StampedPosition>& poses,
@@ -60,9 +61,12 @@ Status DoubleIntegrateSpecificForce(const ImuSample& start, const std::vector<Im
 
 /// The least-squares v0 and g above. FailedPrecondition with fewer than 3
 /// positions or a span under 0.2 s (g is not separable from v0).
-Status AlignVelocityAndGravity(const ImuSample& start, const std::vector<ImuSample>& samples,
-                               double acceleration_to_m_s2, const Eigen::Vector3d& gyro_bias_rad_s,
+Status AlignVelocityAndGravity(const ImuSample& start,
+                               const std::vector<ImuSample>& samples,
+                               double acceleration_to_m_s2,
+                               const Eigen::Vector3d& gyro_bias_rad_s,
                                const std::vector<StampedPosition>& positions,
-                               double position_stddev_floor_m, VelocityGravityAlignment* result);
+                               double position_stddev_floor_m,
+                               VelocityGravityAlignment* result);
 
 }  // namespace swarmlio::lio

@@ -24,15 +24,15 @@ struct InFlightInitOptions {
   // mean specific force), each next from the previous fit; the last fit starts
   // the odometry, which then processes the buffered scans with the teammates.
   int passes = 3;
-  double coarse_velocity_stddev_m_s = 2.0;   // first pass: 1-sigma of v = 0 [m/s]
-  double coarse_gravity_stddev_m_s2 = 3.0;   // first pass: 1-sigma of the coarse g [m/s^2]
+  double coarse_velocity_stddev_m_s = 2.0;  // first pass: 1-sigma of v = 0 [m/s]
+  double coarse_gravity_stddev_m_s2 = 3.0;  // first pass: 1-sigma of the coarse g [m/s^2]
   // Prior of b_g (0 in the first pass, then the pass's estimate): no static
   // mean to take it from; the simulated Avia's built-in IMU has 0.07 rad/s [rad/s].
   double gyro_bias_stddev_rad_s = 0.05;
-  double position_stddev_floor_m = 0.01;     // least sigma of a fitted scan position [m]
-  double velocity_stddev_floor_m_s = 0.02;   // added to the fitted velocity sigma [m/s]
-  double gravity_stddev_floor_m_s2 = 0.02;   // added to the fitted gravity sigma [m/s^2]
-  double max_rms_residual_m = 0.1;           // worse fit: the initialization starts over [m]
+  double position_stddev_floor_m = 0.01;    // least sigma of a fitted scan position [m]
+  double velocity_stddev_floor_m_s = 0.02;  // added to the fitted velocity sigma [m/s]
+  double gravity_stddev_floor_m_s2 = 0.02;  // added to the fitted gravity sigma [m/s^2]
+  double max_rms_residual_m = 0.1;          // worse fit: the initialization starts over [m]
 
   template <class V>
   void VisitFields(V&& v) {
@@ -43,7 +43,8 @@ struct InFlightInitOptions {
     v("coarse_velocity_stddev_m_s", coarse_velocity_stddev_m_s,
       FieldSpec::Positive("m/s", "first pass: 1-sigma of the velocity guess 0"));
     v("coarse_gravity_stddev_m_s2", coarse_gravity_stddev_m_s2,
-      FieldSpec::Positive("m/s^2", "first pass: 1-sigma of the gravity guess (mean specific force)"));
+      FieldSpec::Positive("m/s^2",
+                          "first pass: 1-sigma of the gravity guess (mean specific force)"));
     v("gyro_bias_stddev_rad_s", gyro_bias_stddev_rad_s,
       FieldSpec::Positive("rad/s", "1-sigma of the gyro-bias prior 0"));
     v("position_stddev_floor_m", position_stddev_floor_m,
@@ -53,7 +54,8 @@ struct InFlightInitOptions {
     v("gravity_stddev_floor_m_s2", gravity_stddev_floor_m_s2,
       FieldSpec::Positive("m/s^2", "added to the fitted gravity 1-sigma"));
     v("max_rms_residual_m", max_rms_residual_m,
-      FieldSpec::Positive("m", "rms residual of the fit above which the initialization starts over"));
+      FieldSpec::Positive("m",
+                          "rms residual of the fit above which the initialization starts over"));
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };

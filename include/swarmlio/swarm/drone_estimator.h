@@ -95,7 +95,8 @@ struct DroneEstimatorCounters {
   int64_t passive_fused = 0;
   int64_t passive_repeated = 0;     // of passive_fused: sent again after the first message (lost)
   int64_t repeats_duplicate = 0;    // observations of this drone received twice: used once
-  int64_t extrinsics_stale = 0;     // T_Gj_Gi from before this session, T_Gj_Gk from before k restarted: ignored
+  // Ignored: T_Gj_Gi from before this session, T_Gj_Gk from before k restarted.
+  int64_t extrinsics_stale = 0;
   int64_t gravity_fused = 0;
   int64_t observations_rejected = 0;
   int64_t front_end_errors = 0;
