@@ -145,7 +145,7 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
     // identification would compose them: off by its motion since its start).
     for (auto& [id, other] : impl_->teammates) other.identified.erase(m->sender_id);
     info.taken_observation_stamps.clear();
-    detector_->ForgetTeammate(m->sender_id);
+    detector_->RestartTeammate(m->sender_id, Seconds(received.arrival_ns));
     impl_->mutual.erase(m->sender_id);
     impl_->passive.erase(std::remove_if(impl_->passive.begin(), impl_->passive.end(),
                                         [&](const PendingPassive& p) {
