@@ -12,7 +12,9 @@
 #
 # Environment: SCENARIO (indoor_3uav), RATE (1), IMPERFECTIONS (realistic), SEED (the file's),
 # CLOCK_OFFSETS (the drones' clock offsets for the simulation, e.g. "0,0.5,-0.5"), LIVE_ARGS
-# (more swarmlio_live flags, e.g. "--network_poll_period_ms=0.5"),
+# (more swarmlio_live flags, e.g. "--network_poll_period_ms=0.5"), LATE_INIT (in_flight: the
+# odometry.initialization of a JOIN or RESTART drone, which starts while flying; static: as
+# before the in-flight initializer),
 # UDP_MODE (unicast: multicast needs a route on loopback), BASE_PORT (9100), OUT
 # (results/live/<scenario>), BUILD_DIR (build). Exit code 1 if a step fails; the comparison
 # is printed, not judged.
@@ -79,11 +81,11 @@ if [[ -n "${PROXY:-}" ]]; then
   "$PROXY_TOOL" --routes "$routes" $PROXY > "$OUT/proxy.log" 2>&1 &
   proxy_pid=$!
 fi
-launch() {  # launch <index> <output dir> <log offset s> <wall start> <log suffix> (pid in LAUNCHED)
-  local i=$1 name="${drones[$1]}"
+launch() {  # launch <index> <output dir> <log offset s> <wall start> <log suffix> [more flags]
+  local i=$1 name="${drones[$1]}"      # (pid in LAUNCHED)
   local args=(--manifest "$OUT/sim/swarm.yaml" --drone "$name" --key_file "$key" --rate "$RATE"
               --output_dir "$2" --imu_odom=false --udp_mode "$UDP_MODE" --start_s "$3"
-              --start_at_unix_s "$4" ${LIVE_ARGS:-})
+              --start_at_unix_s "$4" ${6:-} ${LIVE_ARGS:-})
   if [[ "$UDP_MODE" == unicast ]]; then
     args+=(--port "$((BASE_PORT + i + 1))" --peers "$peers")
   else
@@ -105,7 +107,8 @@ for i in "${!drones[@]}"; do
 done
 if [[ -n "${JOIN:-}" ]]; then  # (a RESTART is assumed to come after the JOIN)
   sleep_until "$(plus "$t0" "$(plus "$join_s" -2)")"  # opens its log, then waits for its start
-  launch "$join_index" "$OUT/live" "$(times "$join_s" "$RATE")" "$(plus "$t0" "$join_s")" ""
+  launch "$join_index" "$OUT/live" "$(times "$join_s" "$RATE")" "$(plus "$t0" "$join_s")" "" \
+      "--initialization=${LATE_INIT:-in_flight}"
   pids[$join_index]=$LAUNCHED
 fi
 if [[ -n "${RESTART:-}" ]]; then
@@ -116,7 +119,7 @@ if [[ -n "${RESTART:-}" ]]; then
   restart_at=$(plus "$restart_s" 1)  # down for a second
   echo "killed $restart_name ${restart_s} s into the run; back at ${restart_at} s, its log from there"
   launch "$restart_index" "$OUT/live_restart" "$(times "$restart_at" "$RATE")" \
-      "$(plus "$t0" "$restart_at")" "_restart"
+      "$(plus "$t0" "$restart_at")" "_restart" "--initialization=${LATE_INIT:-in_flight}"
   pids[$restart_index]=$LAUNCHED
 fi
 failed=0

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
+
+#include "swarmlio/math/so3.h"
 
 namespace swarmlio {
 namespace {
@@ -99,6 +102,11 @@ std::string ImuInitialization::Summary() const {
       break;
   }
   os << ", " << angle_to_up_axis_deg << " deg from up_axis";
+  if (in_flight) {
+    os << "; in flight: v_b_in_G = [" << state.v_b_in_G.transpose() << "] m/s from "
+       << alignment_passes << " LiDAR passes (" << alignment_num_poses << " scan positions, rms "
+       << alignment_rms_m << " m)";
+  }
   if (!sign_warning.empty()) os << "; WARNING: " << sign_warning;
   return os.str();
 }
@@ -146,21 +154,21 @@ bool ImuInitializer::WindowFull() const {
   return static_cast<int>(window_.size()) >= options_.window_num_samples;
 }
 
-Status ImuInitializer::Initialize(ImuInitialization* result) const {
-  if (!WindowFull()) {
-    std::ostringstream os;
-    os << "imu initializer: window not full (" << window_.size() << " samples";
-    if (options_.window_duration_s > 0.0) {
-      os << ", need " << options_.window_duration_s << " s";
-    } else {
-      os << ", need " << options_.window_num_samples;
-    }
-    os << ")";
-    return Status::FailedPrecondition(os.str());
-  }
-  const WindowStatistics stats = ComputeStatistics(window_);
+struct ImuInitializer::UnitAndSign {
+  AccelerationUnit unit = AccelerationUnit::kMetersPerSecondSquared;
+  bool detected = false;
+  double unit_factor = 1.0;
+  SpecificForceDirection direction = SpecificForceDirection::kUndetermined;
+  double angle_deg = 0.0;
+  int sign = 1;
+  bool sign_detected = false;
+  std::string sign_warning;
+};
+
+Status ImuInitializer::DetermineUnitAndSign(const Eigen::Vector3d& mean_accel,
+                                            UnitAndSign* out) const {
   const double g0 = options_.nominal_gravity_m_s2;
-  const double raw_norm = stats.mean_accel.norm();
+  const double raw_norm = mean_accel.norm();
 
   // 1. Unit: configured, or detected from |mean a_m| (~1 -> g, ~9.8 -> m/s^2).
   AccelerationUnit unit = AccelerationUnit::kMetersPerSecondSquared;
@@ -196,7 +204,7 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   SpecificForceDirection direction = SpecificForceDirection::kUndetermined;
   double angle_deg = 0.0;
   if (options_.up_axis != ImuUpAxis::kNone && raw_norm > 0.0) {
-    const double c = std::clamp(stats.mean_accel.dot(up) / raw_norm, -1.0, 1.0);
+    const double c = std::clamp(mean_accel.dot(up) / raw_norm, -1.0, 1.0);
     angle_deg = std::acos(c) * 180.0 / M_PI;
     if (angle_deg <= options_.max_up_axis_angle_deg) {
       direction = SpecificForceDirection::kUp;
@@ -232,6 +240,42 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
                             "0 = auto), or imu_init.up_axis to the IMU's up axis";
     }
   }
+  out->unit = unit;
+  out->detected = detected;
+  out->unit_factor = unit_factor;
+  out->direction = direction;
+  out->angle_deg = angle_deg;
+  out->sign = sign;
+  out->sign_detected = sign_detected;
+  out->sign_warning = sign_warning;
+  return Status::Ok();
+}
+
+Status ImuInitializer::Initialize(ImuInitialization* result) const {
+  if (!WindowFull()) {
+    std::ostringstream os;
+    os << "imu initializer: window not full (" << window_.size() << " samples";
+    if (options_.window_duration_s > 0.0) {
+      os << ", need " << options_.window_duration_s << " s";
+    } else {
+      os << ", need " << options_.window_num_samples;
+    }
+    os << ")";
+    return Status::FailedPrecondition(os.str());
+  }
+  const WindowStatistics stats = ComputeStatistics(window_);
+  const double g0 = options_.nominal_gravity_m_s2;
+  const double raw_norm = stats.mean_accel.norm();
+  UnitAndSign us;
+  SWARMLIO_RETURN_IF_ERROR(DetermineUnitAndSign(stats.mean_accel, &us));
+  const AccelerationUnit unit = us.unit;
+  const bool detected = us.detected;
+  const double unit_factor = us.unit_factor;
+  const SpecificForceDirection direction = us.direction;
+  const double angle_deg = us.angle_deg;
+  const int sign = us.sign;
+  const bool sign_detected = us.sign_detected;
+  const std::string& sign_warning = us.sign_warning;
   const double factor = sign * unit_factor;
 
   // 2. Static test on the window (standard deviations in SI units).
@@ -266,6 +310,7 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   ImuInitialization& r = *result;
   r = ImuInitialization();
   r.stamp_ns = window_.back().stamp_ns;
+  r.started_ns = r.stamp_ns;
   r.last_sample = window_.back();
   r.state = EgoState();
   r.state.gyro_bias = stats.mean_gyro;
@@ -306,6 +351,83 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   P.block<3, 3>(L::kAccelBias.offset, L::kAccelBias.offset) = sba * sba * I;
   P.block<3, 3>(L::kGravity.offset, L::kGravity.offset) =
       sba * sba * I + unit_factor * unit_factor * stats.cov_accel / n + sg * sg * I;
+  P.block<3, 3>(L::kGravity.offset, L::kAccelBias.offset) = sba * sba * I;
+  P.block<3, 3>(L::kAccelBias.offset, L::kGravity.offset) = sba * sba * I;
+  return Status::Ok();
+}
+
+Status ImuInitializer::InitializeInFlight(const InFlightCoarseSigmas& coarse,
+                                         ImuInitialization* result) const {
+  if (!WindowFull()) {
+    return Status::FailedPrecondition("imu initializer: window not full (" +
+                                      std::to_string(window_.size()) + " samples)");
+  }
+  // The mean specific force in G (the IMU frame at the window's end): each
+  // sample rotated by the gyro integrated back from the end (bias unknown,
+  // taken as 0; the error is a second-order effect on a coarse guess).
+  const int n = static_cast<int>(window_.size());
+  std::vector<Eigen::Matrix3d> R_G_bk(n, Eigen::Matrix3d::Identity());
+  for (int k = n - 2; k >= 0; --k) {
+    const double dt = static_cast<double>(window_[k + 1].stamp_ns - window_[k].stamp_ns) * 1e-9;
+    const Eigen::Vector3d w =
+        0.5 * (window_[k].angular_velocity_rad_s + window_[k + 1].angular_velocity_rad_s);
+    R_G_bk[k] = R_G_bk[k + 1] * so3::Exp(-dt * w);
+  }
+  Eigen::Vector3d mean_in_G = Eigen::Vector3d::Zero();
+  for (int k = 0; k < n; ++k) {
+    mean_in_G += R_G_bk[k] * window_[k].linear_acceleration;
+  }
+  mean_in_G /= n;
+  // Unit and sign as at rest: in flight the mean specific force is still
+  // gravity plus the (smaller) mean acceleration of the flight.
+  UnitAndSign us;
+  SWARMLIO_RETURN_IF_ERROR(DetermineUnitAndSign(mean_in_G, &us));
+  const double factor = us.sign * us.unit_factor;
+  const double g0 = options_.nominal_gravity_m_s2;
+  const double g_norm = us.unit_factor * mean_in_G.norm();
+  constexpr double kMaxInFlightRatio = 0.5;
+  if (!(std::abs(g_norm / g0 - 1.0) <= kMaxInFlightRatio)) {
+    std::ostringstream os;
+    os << "imu initializer (in flight): mean specific force " << g_norm << " m/s^2 with unit "
+       << config::EnumToString(us.unit) << " is not within " << kMaxInFlightRatio * 100
+       << " % of " << g0 << " m/s^2; check acceleration_unit";
+    return Status::FailedPrecondition(os.str());
+  }
+  ImuInitialization& r = *result;
+  r = ImuInitialization();
+  r.stamp_ns = window_.back().stamp_ns;
+  r.started_ns = r.stamp_ns;
+  r.last_sample = window_.back();
+  r.state = EgoState();
+  r.state.g_in_G = -factor * mean_in_G;
+  r.acceleration_unit = us.unit;
+  r.unit_detected = us.detected;
+  r.acceleration_to_m_s2 = factor;
+  r.gravity_magnitude_m_s2 = g_norm;
+  r.num_samples = n;
+  r.reported_direction = us.direction;
+  r.angle_to_up_axis_deg = us.angle_deg;
+  r.acceleration_sign = us.sign;
+  r.sign_detected = us.sign_detected;
+  r.sign_warning = us.sign_warning;
+  r.in_flight = true;
+
+  auto& P = r.covariance;
+  P.setZero();
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const double sr = options_.initial_rotation_stddev_rad;
+  const double sp = options_.initial_position_stddev_m;
+  const double sv = coarse.velocity_m_s;
+  const double sbg = coarse.gyro_bias_rad_s;
+  const double sba = options_.initial_accel_bias_stddev_m_s2;
+  const double sg = coarse.gravity_m_s2;
+  P.block<3, 3>(L::kRotation.offset, L::kRotation.offset) = sr * sr * I;
+  P.block<3, 3>(L::kPosition.offset, L::kPosition.offset) = sp * sp * I;
+  P.block<3, 3>(L::kVelocity.offset, L::kVelocity.offset) = sv * sv * I;
+  P.block<3, 3>(L::kGyroBias.offset, L::kGyroBias.offset) = sbg * sbg * I;
+  P.block<3, 3>(L::kAccelBias.offset, L::kAccelBias.offset) = sba * sba * I;
+  // As at rest, only g - b_a enters the specific force: equal errors.
+  P.block<3, 3>(L::kGravity.offset, L::kGravity.offset) = (sba * sba + sg * sg) * I;
   P.block<3, 3>(L::kGravity.offset, L::kAccelBias.offset) = sba * sba * I;
   P.block<3, 3>(L::kAccelBias.offset, L::kGravity.offset) = sba * sba * I;
   return Status::Ok();

@@ -8,14 +8,18 @@
 #include "swarmlio/lio/esikf_update.h"
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
+#include "swarmlio/lio/in_flight_alignment.h"
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/preprocess.h"
 #include "swarmlio/lio/scan_association.h"
 #include "swarmlio/lio/undistortion.h"
+#include "odometry_impl.h"
 #include "window_smoother.h"
 
 namespace swarmlio::lio {
 namespace {
+
+using internal::PendingScan;
 
 using Clock = std::chrono::steady_clock;
 
@@ -37,39 +41,7 @@ bool IsFinite(const SwarmState& x, const Eigen::MatrixXd& P) {
          x.ego.accel_bias.allFinite() && x.ego.g_in_G.allFinite() && P.allFinite();
 }
 
-struct PendingScan {
-  LidarScan scan;
-  int64_t end_ns = 0;
-};
-
 }  // namespace
-
-struct Odometry::Impl {
-  std::unique_ptr<ImuInitializer> initializer;
-  ImuInitialization initialization;
-  bool initialized = false;
-  std::unique_ptr<ImuPropagator> propagator;
-  std::unique_ptr<Preprocess> preprocess;
-  LocalMap map;
-  ScanAssociator associator;
-  EsikfUpdate update;
-  std::unique_ptr<internal::WindowSmoother> window;  // estimator: window
-  std::deque<ImuSample> imu_queue;  // after initialization, not yet propagated
-  std::deque<PendingScan> scan_queue;
-  std::deque<PendingScan> static_start_scans;  // before initialization (map seeding)
-  std::vector<ScanOutput> outputs;
-  int64_t last_imu_stamp_ns = 0;
-  bool have_imu = false;
-  int64_t last_scan_end_ns = 0;
-  bool have_scan = false;
-  bool previous_degenerate = false;  // the last updated scan's flag (front end)
-  // Scratch reused between scans.
-  std::vector<PointXYZT> points_in_b;
-  std::vector<Eigen::Vector3d> undistorted;
-
-  Impl(const OdometryOptions& options)
-      : map(options.map), associator(&map, options.association), update(options.update) {}
-};
 
 Status Odometry::Create(const OdometryOptions& options, const LidarOptions& lidar,
                         std::unique_ptr<Odometry>* odometry) {
@@ -98,7 +70,7 @@ Odometry::Odometry(const OdometryOptions& options, const LidarOptions& lidar)
 
 Odometry::~Odometry() = default;
 
-bool Odometry::initialized() const { return impl_->initialized; }
+bool Odometry::initialized() const { return impl_->initialized && !impl_->probe.active; }
 const ImuInitialization& Odometry::initialization() const { return impl_->initialization; }
 const SwarmState& Odometry::state() const { return impl_->propagator->state(); }
 const Eigen::MatrixXd& Odometry::covariance() const { return impl_->propagator->covariance(); }
@@ -135,7 +107,13 @@ Status Odometry::AddImu(const ImuSample& raw) {
       return Status::Ok();
     }
     ImuInitialization init;
-    const Status status = impl_->initializer->Initialize(&init);
+    const bool in_flight = options_.initialization == InitializationMode::kInFlight;
+    ImuInitializer::InFlightCoarseSigmas coarse;
+    coarse.velocity_m_s = options_.in_flight.coarse_velocity_stddev_m_s;
+    coarse.gravity_m_s2 = options_.in_flight.coarse_gravity_stddev_m_s2;
+    coarse.gyro_bias_rad_s = options_.in_flight.gyro_bias_stddev_rad_s;
+    const Status status = in_flight ? impl_->initializer->InitializeInFlight(coarse, &init)
+                                    : impl_->initializer->Initialize(&init);
     if (!status.ok()) {
       init_error_ = status.message();
       return Status::Ok();  // keep sliding the window
@@ -143,11 +121,16 @@ Status Odometry::AddImu(const ImuSample& raw) {
     SWARMLIO_RETURN_IF_ERROR(impl_->propagator->Reset(init));
     impl_->initialization = init;
     impl_->initialized = true;
+    if (in_flight) {
+      StartInFlightProbe(init);
+      return Status::Ok();
+    }
     init_error_.clear();
     SeedMapFromStaticStart(impl_->initializer->window_start_ns());
     return Status::Ok();
   }
   impl_->imu_queue.push_back(sample);
+  if (impl_->probe.active) impl_->probe.imu.push_back(sample);
   return ProcessReadyScans(/*flush=*/false);
 }
 
@@ -179,6 +162,7 @@ Status Odometry::AddScan(const LidarScan& scan) {
                                    " ns does not end after the previous scan; dropped");
   }
   impl_->scan_queue.push_back({scan, end_ns});
+  if (impl_->probe.active) impl_->probe.scans.push_back({scan, end_ns});
   Status status;
   if (static_cast<int>(impl_->scan_queue.size()) > options_.max_queued_scans) {
     ++counters_.scans_dropped_queue;
@@ -259,6 +243,12 @@ Status Odometry::ProcessReadyScans(bool flush) {
     impl_->scan_queue.pop_front();
     const Status status = ProcessScan(pending.scan, pending.end_ns, flush);
     if (!status.ok() && first_error.ok()) first_error = status;
+    const internal::InFlightProbe& probe = impl_->probe;
+    if (probe.active &&
+        pending.end_ns - probe.start.stamp_ns >=
+            static_cast<int64_t>(std::llround(options_.in_flight.probe_duration_s * 1e9))) {
+      FinishInFlightPass();  // restarts from t0 (queues refilled) or abandons
+    }
   }
   return first_error;
 }
@@ -322,17 +312,19 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
   out.timings.undistort_s = SecondsSince(t);
 
   // 3b. Front end of the hooks (may change the state's teammate blocks).
+  // An in-flight probe pass runs without them (its states are provisional).
+  ScanStageHooks* hooks = im.probe.active ? nullptr : hooks_;
   SwarmState x = prop.state();
   Eigen::MatrixXd P = prop.covariance();
   UpdateRequest request;
-  if (hooks_ != nullptr) {
+  if (hooks != nullptr) {
     t = Clock::now();
     FrontEndScan front;
     front.raw = &scan;
     front.end_stamp_ns = prop.stamp_ns();
     front.poses = &prop.scan_poses();
     front.previous_scan_degenerate = im.previous_degenerate;
-    const Status status = hooks_->OnFrontEnd(front, &x, &P, &request);
+    const Status status = hooks->OnFrontEnd(front, &x, &P, &request);
     if (!status.ok()) {
       out.hook_error = status.message();
       request = UpdateRequest();
@@ -356,7 +348,14 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
   im.last_scan_end_ns = end_ns;
   im.have_scan = true;
   ++counters_.scans_processed;
-  if (hooks_ != nullptr) hooks_->OnScanDone(out, x, P);
+  if (im.probe.active) {
+    if (out.updated) {
+      im.probe.positions.push_back({out.stamp_ns, out.state.p_b_in_G, out.state.q_G_b});
+      im.probe.gyro_bias = out.state.gyro_bias;
+    }
+    return first_error;
+  }
+  if (hooks != nullptr) hooks->OnScanDone(out, x, P);
   im.outputs.push_back(std::move(out));
   return first_error;
 }
@@ -378,7 +377,9 @@ void Odometry::UpdateWithFilter(const UpdateRequest& request, SwarmState* x_io,
     std::vector<MeasurementModel*> models{&planes};
     models.insert(models.end(), request.models.begin(), request.models.end());
     const EsikfUpdateResult result =
-        im.update.Run(x, P, models, hooks_ != nullptr ? &request.estimated_teammates : nullptr);
+        im.update.Run(x, P, models,
+                      hooks_ != nullptr && !im.probe.active ? &request.estimated_teammates
+                                                            : nullptr);
     out->timings.association_s = result.association_time_s;
     out->timings.solve_s = result.solve_time_s;
     out->timings.covariance_s = result.covariance_time_s;

@@ -1,5 +1,6 @@
 #include "swarmlio/replay/drone_runner.h"
 
+#include <cmath>
 #include <utility>
 
 namespace swarmlio::replay {
@@ -8,16 +9,31 @@ Status DroneRunner::Create(const DroneInput& input, int drone_id,
                            std::unique_ptr<DroneRunner>* runner) {
   std::unique_ptr<DroneRunner> r(new DroneRunner());
   r->input_ = input;
+  r->drone_id_ = drone_id;
   Status status = io::BagReader::Open(input.bag_path, input.bag, &r->reader_);
   if (!status.ok()) return status.WithContext(input.name);
-  swarm::DroneEstimatorOptions options;
-  options.odometry = input.odometry;
-  options.teammate = input.teammate;
-  options.swarm = input.swarm;
-  status = swarm::DroneEstimator::Create(drone_id, options, input.lidar, &r->estimator_);
+  status = r->CreateEstimator(input.odometry.initialization);
   if (!status.ok()) return status.WithContext(input.name);
   status = r->ReadNext();
   if (!status.ok()) return status.WithContext(input.name);
+  if (input.restart_at_s > 0.0 && r->has_next_) {
+    r->restart_ns_ =
+        r->next_.stamp_ns() + static_cast<int64_t>(std::llround(input.restart_at_s * 1e9));
+  }
+  if (input.start_offset_s > 0.0 && r->has_next_) {
+    // A late join or a restart mid-flight: the drone starts later in its log.
+    const int64_t start_ns =
+        r->next_.stamp_ns() + static_cast<int64_t>(std::llround(input.start_offset_s * 1e9));
+    while (r->has_next_ && r->next_.stamp_ns() < start_ns) {
+      status = r->ReadNext();
+      if (!status.ok()) return status.WithContext(input.name);
+    }
+    if (!r->has_next_) {
+      return Status::InvalidArgument(input.name + ": start_offset_s " +
+                                     std::to_string(input.start_offset_s) +
+                                     " s is beyond the end of the log");
+    }
+  }
   *runner = std::move(r);
   return Status::Ok();
 }
@@ -71,7 +87,33 @@ void DroneRunner::TakeMessages(std::vector<net::SwarmMessage>* messages) {
   estimator_->PopMessages(messages);
 }
 
-void DroneRunner::SetFusion(bool fuse) { estimator_->SetFusion(fuse); }
+void DroneRunner::SetFusion(bool fuse) {
+  fuse_ = fuse;
+  estimator_->SetFusion(fuse);
+}
+
+Status DroneRunner::CreateEstimator(lio::InitializationMode initialization) {
+  swarm::DroneEstimatorOptions options;
+  options.odometry = input_.odometry;
+  options.odometry.initialization = initialization;
+  options.teammate = input_.teammate;
+  options.swarm = input_.swarm;
+  SWARMLIO_RETURN_IF_ERROR(
+      swarm::DroneEstimator::Create(drone_id_, options, input_.lidar, &estimator_));
+  estimator_->SetFusion(fuse_);
+  return Status::Ok();
+}
+
+Status DroneRunner::Restart() {
+  restart_ns_ = -1;
+  SWARMLIO_RETURN_IF_ERROR(CreateEstimator(input_.restart_initialization));
+  const int64_t back_ns =
+      next_.stamp_ns() + static_cast<int64_t>(std::llround(input_.restart_down_s * 1e9));
+  while (has_next_ && next_.stamp_ns() < back_ns) SWARMLIO_RETURN_IF_ERROR(ReadNext());
+  scans_.clear();
+  identifications_.clear();
+  return Status::Ok();
+}
 
 int64_t DroneRunner::next_stamp_ns() const { return next_.stamp_ns(); }
 
@@ -87,6 +129,11 @@ void DroneRunner::Warn(const Status& status) {
 
 Status DroneRunner::Step() {
   if (!has_next_) return Status::OutOfRange(input_.name + ": no record left");
+  if (restart_ns_ >= 0 && next_.stamp_ns() >= restart_ns_) {
+    const Status restarted = Restart();
+    // The record after the down time is fed at its own turn.
+    return restarted.ok() ? restarted : restarted.WithContext(input_.name);
+  }
   if (const ImuSample* imu = next_.imu()) {
     Warn(estimator_->AddImu(*imu));
   } else if (const LidarScan* scan = next_.scan()) {

@@ -28,6 +28,10 @@ struct DroneEntry {
   teammate::TeammateDetectorOptions teammate;
   swarm::SwarmOptions swarm;
   TrueClock true_clock;
+  double start_offset_s = 0.0;
+  double restart_at_s = 0.0;
+  double restart_down_s = 1.0;
+  lio::InitializationMode restart_initialization = lio::InitializationMode::kInFlight;
   Eigen::Vector3d p_G_in_W_m = Eigen::Vector3d::Zero();
   std::vector<double> q_W_G_xyzw = {0.0, 0.0, 0.0, 1.0};
 
@@ -50,6 +54,19 @@ struct DroneEntry {
     v("teammate", teammate);
     v("swarm", swarm);
     v("true_clock", true_clock);
+    v("start_offset_s", start_offset_s,
+      FieldSpec::InRange(0.0, 1e6, "s",
+                         "skip the log's first seconds: the drone starts later (a late join or "
+                         "a restart in flight; pair with odometry: {initialization: in_flight})"));
+    v("restart_at_s", restart_at_s,
+      FieldSpec::InRange(0.0, 1e6, "s",
+                         "kill the drone's estimator this far into its log and start a new "
+                         "session restart_down_s later (0 = never)"));
+    v("restart_down_s", restart_down_s,
+      FieldSpec::InRange(0.0, 1e3, "s", "time the restarted drone is down"));
+    v("restart_initialization", restart_initialization,
+      FieldSpec::Doc("odometry.initialization of the restarted session: in_flight (default) or "
+                     "static"));
     v("p_G_in_W_m", p_G_in_W_m,
       FieldSpec::InRange(-1e7, 1e7, "m", "origin of G in a common world frame (plots only)"));
     v("q_W_G_xyzw", q_W_G_xyzw,
@@ -139,6 +156,10 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     d.ground_truth_frame = e.ground_truth_frame;
     d.bag = e.bag_topics;
     d.true_clock = e.true_clock;
+    d.start_offset_s = e.start_offset_s;
+    d.restart_at_s = e.restart_at_s;
+    d.restart_down_s = e.restart_down_s;
+    d.restart_initialization = e.restart_initialization;
     d.p_G_in_W_m = e.p_G_in_W_m;
     d.R_W_G = Eigen::Quaterniond(e.q_W_G_xyzw[3], e.q_W_G_xyzw[0], e.q_W_G_xyzw[1], e.q_W_G_xyzw[2])
                   .normalized()

@@ -28,6 +28,20 @@ using internal::TeammateInfo;
 
 }  // namespace
 
+bool DroneEstimator::MadeInSessionOf(int teammate_id, int sender_id,
+                                     int64_t sender_stamp_ns) const {
+  const auto it = impl_->teammates.find(teammate_id);
+  if (it == impl_->teammates.end() || it->second.session_heard_ns == 0) return true;
+  int64_t local_ns = sender_stamp_ns;
+  if (impl_->clock_sync != nullptr &&
+      !impl_->clock_sync->ToLocal(sender_id, sender_stamp_ns, &local_ns)) {
+    return false;  // its clock is not known yet
+  }
+  const int64_t margin_ns =
+      static_cast<int64_t>(std::llround(options_.swarm.max_message_age_s * 1e9));
+  return local_ns >= it->second.session_heard_ns + margin_ns;
+}
+
 bool DroneEstimator::MadeInThisSession(int sender_id, int64_t sender_stamp_ns) const {
   if (!odometry_->initialized()) return false;
   int64_t local_ns = sender_stamp_ns;
@@ -37,7 +51,9 @@ bool DroneEstimator::MadeInThisSession(int sender_id, int64_t sender_stamp_ns) c
   }
   const int64_t margin_ns =
       static_cast<int64_t>(std::llround(options_.swarm.max_message_age_s * 1e9));
-  return local_ns >= odometry_->initialization().stamp_ns + margin_ns;
+  // Teammates hear this session with its first state message, sent once the
+  // odometry started (after an in-flight initialization's passes).
+  return local_ns >= odometry_->initialization().started_ns + margin_ns;
 }
 
 Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
@@ -75,7 +91,13 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
           ++counters_.extrinsics_stale;
         }
       } else if (e.source == net::ExtrinsicSource::kTrajectoryMatch) {
-        impl_->teammates[g->sender_id].identified[e.teammate_id] = e;
+        // Likewise about a third drone k that restarted: the sender keeps
+        // its T_Gj_Gk of k's old G_k until it hears k's new session.
+        if (MadeInSessionOf(e.teammate_id, g->sender_id, g->stamp_ns)) {
+          impl_->teammates[g->sender_id].identified[e.teammate_id] = e;
+        } else {
+          ++counters_.extrinsics_stale;
+        }
       }
     }
     // A zero vector: an old sender without gravity; ignored.
@@ -119,8 +141,12 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
     info.restarted = true;
     info.have_message = false;
     info.identified.clear();  // its T_Gj_Gk were in its old G_j
+    info.session_heard_ns = received.arrival_ns;
+    // The other teammates' T_Gk_Gj were about its old G_j (graph
+    // identification would compose them: off by its motion since its start).
+    for (auto& [id, other] : impl_->teammates) other.identified.erase(m->sender_id);
     info.taken_observation_stamps.clear();
-    detector_->ForgetTeammate(m->sender_id);
+    detector_->RestartTeammate(m->sender_id, Seconds(received.arrival_ns));
     impl_->mutual.erase(m->sender_id);
     impl_->passive.erase(std::remove_if(impl_->passive.begin(), impl_->passive.end(),
                                         [&](const PendingPassive& p) {

@@ -25,6 +25,10 @@ struct TeammateInfo {
   int64_t last_heard_ns = 0;       // arrival of the newest message (own clock)
   int64_t last_seen_ns = 0;        // last LiDAR observation (own clock)
   bool restarted = false;          // session_start changed: drop its block
+  // Arrival (own clock) of the first message of its current session when it
+  // restarted (0: its first session): the other teammates' T_Gk_Gj about it
+  // made before this + max_message_age_s are of its old G_j.
+  int64_t session_heard_ns = 0;
   bool via_graph = false;          // its block came through a teammate's T_Gj_Gk
   // j's clock stamps of the observations of this drone already taken (j
   // repeats observations, SwarmOptions::repeat_observations): the newest few.

@@ -261,7 +261,8 @@ void TeammateDetector::Identify(double stamp_s, ScanResult* result) {
     if (teammates_.count(match.drone_id) > 0) continue;
     teammates_.emplace(match.drone_id,
                        TeammateTracker(match.drone_id, tracker.id(), match.match.R_Gi_Gj,
-                                       match.match.p_Gj_in_Gi, tracker.filter()));
+                                       match.match.p_Gj_in_Gi, tracker.filter(),
+                                       options_.excitation.max_positions));
     TeammateIdentification id;
     id.drone_id = match.drone_id;
     id.tracker_id = tracker.id();
@@ -347,8 +348,19 @@ bool TeammateDetector::AddIdentifiedTeammate(int drone_id, double stamp_s,
   filter.Initialize(stamp_s, R_Gi_Gj * p_bj_in_Gj + p_Gj_in_Gi, R_Gi_Gj * v_bj_in_Gj,
                     o.odometry_position_sigma_m, o.velocity_sigma_m_s);
   teammates_.emplace(drone_id,
-                     TeammateTracker(drone_id, next_tracker_id_++, R_Gi_Gj, p_Gj_in_Gi, filter));
+                     TeammateTracker(drone_id, next_tracker_id_++, R_Gi_Gj, p_Gj_in_Gi, filter,
+                                     options_.excitation.max_positions));
   return true;
+}
+
+bool TeammateDetector::RestartTeammate(int drone_id, double stamp_s) {
+  const auto it = teammates_.find(drone_id);
+  if (it != teammates_.end() && !it->second.seen_trajectory().empty()) {
+    temporary_.emplace_back(it->second.tracker_id(), stamp_s, it->second.filter(),
+                            it->second.seen_trajectory());
+    seen_temporary_.push_back(false);
+  }
+  return ForgetTeammate(drone_id);
 }
 
 bool TeammateDetector::ForgetTeammate(int drone_id) {

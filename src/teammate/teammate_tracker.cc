@@ -6,12 +6,13 @@ namespace swarmlio::teammate {
 
 TeammateTracker::TeammateTracker(int drone_id, int tracker_id, const Eigen::Matrix3d& R_Gi_Gj,
                                  const Eigen::Vector3d& p_Gj_in_Gi,
-                                 const ConstantVelocityFilter& filter)
+                                 const ConstantVelocityFilter& filter, int trajectory_capacity)
     : drone_id_(drone_id),
       tracker_id_(tracker_id),
       R_Gi_Gj_(R_Gi_Gj),
       p_Gj_in_Gi_(p_Gj_in_Gi),
-      filter_(filter) {}
+      filter_(filter),
+      seen_(trajectory_capacity) {}
 
 namespace {
 
@@ -64,6 +65,7 @@ void TeammateTracker::UpdateLidar(double stamp_s, const Eigen::Vector3d& p_in_Gi
   const double sigma = options.lidar_position_sigma_m;
   filter_.Update(p_in_Gi, sigma * sigma * Eigen::Matrix3d::Identity());
   last_lidar_update_s_ = stamp_s;
+  seen_.Push(stamp_s, p_in_Gi);
 }
 
 bool TeammateTracker::UpdateOdometry(double stamp_s, const OdometryHistory& history,

@@ -10,6 +10,14 @@ TemporaryTracker::TemporaryTracker(int id, double stamp_s, const Eigen::Vector3d
   trajectory_.Push(stamp_s, p_in_G);
 }
 
+TemporaryTracker::TemporaryTracker(int id, double stamp_s, const ConstantVelocityFilter& filter,
+                                   const TrajectoryBuffer& trajectory)
+    : id_(id),
+      created_s_(stamp_s),
+      last_update_s_(stamp_s),
+      filter_(filter),
+      trajectory_(trajectory) {}
+
 void TemporaryTracker::Update(double stamp_s, const Eigen::Vector3d& p_in_G,
                               const TemporaryTrackerOptions& options) {
   filter_.PredictTo(stamp_s, options.filter.accel_noise_density_m_s2_sqrt_hz);

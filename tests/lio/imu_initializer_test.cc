@@ -336,5 +336,55 @@ TEST(ImuInitializer, PropagatorStartedFromTheResultStaysAtRest) {
   EXPECT_LT(so3::Log(prop->state().ego.q_G_b).norm(), 1e-12);
 }
 
+// In flight: a tilted IMU turning at 1 rad/s about the vertical at constant
+// velocity fails the static test (its mean gyro is the turn), but the
+// in-flight start accepts it; the specific force rotated back into G by the
+// gyro gives g_in_G, the raw mean would be smeared by the turn. Unit and sign
+// are detected as at rest.
+TEST(ImuInitializer, InFlightStartRotatesTheSpecificForceIntoG) {
+  const Eigen::Matrix3d R_tilt = so3::Exp(Eigen::Vector3d(0.15, -0.1, 0.0));
+  const double yaw_rate = 1.0;  // [rad/s]
+  const auto R_W_b = [&](double t) -> Eigen::Matrix3d {
+    return so3::Exp(Eigen::Vector3d(0, 0, yaw_rate * t)) * R_tilt;
+  };
+  for (const double scale : {1.0, 1.0 / kG, -1.0}) {
+    ImuInitializerOptions options;
+    options.acceleration_unit = AccelerationUnitSetting::kAuto;
+    options.acceleration_sign = 0;
+    auto init = Make(options);
+    for (int k = 0; k < 200; ++k) {
+      const double t = k * 1e-9 * kPeriodNs;
+      ImuSample s;
+      s.stamp_ns = 1'000'000'000 + k * kPeriodNs;
+      s.angular_velocity_rad_s = R_tilt.transpose() * Eigen::Vector3d(0, 0, yaw_rate);
+      s.linear_acceleration = scale * R_W_b(t).transpose() * Eigen::Vector3d(0, 0, kG);
+      ASSERT_TRUE(init->AddSample(s).ok());
+    }
+    ImuInitialization r;
+    EXPECT_EQ(init->Initialize(&r).code(), Status::Code::kFailedPrecondition);
+    const Status s = init->InitializeInFlight(ImuInitializer::InFlightCoarseSigmas(), &r);
+    ASSERT_TRUE(s.ok()) << s.message();
+    const double t_end = 199 * 1e-9 * kPeriodNs;
+    const Eigen::Vector3d g_true = R_W_b(t_end).transpose() * Eigen::Vector3d(0, 0, -kG);
+    EXPECT_LT((r.state.g_in_G - g_true).norm(), 0.01)
+        << scale << ": " << r.state.g_in_G.transpose();
+    EXPECT_TRUE(r.in_flight);
+    EXPECT_EQ(r.acceleration_sign, scale < 0 ? -1 : 1);
+    const AccelerationUnit unit = std::abs(scale) < 0.5 ? AccelerationUnit::kStandardGravity
+                                                        : AccelerationUnit::kMetersPerSecondSquared;
+    EXPECT_EQ(r.acceleration_unit, unit);
+    EXPECT_EQ(r.state.v_b_in_G, Eigen::Vector3d::Zero());
+    EXPECT_EQ(r.state.gyro_bias, Eigen::Vector3d::Zero());
+    // The coarse sigmas, and the g - b_a correlation of a static start.
+    const ImuInitializer::InFlightCoarseSigmas coarse;
+    EXPECT_NEAR(r.covariance(L::kVelocity.offset, L::kVelocity.offset),
+                coarse.velocity_m_s * coarse.velocity_m_s, 1e-12);
+    EXPECT_NEAR(r.covariance(L::kGravity.offset, L::kAccelBias.offset),
+                r.covariance(L::kAccelBias.offset, L::kAccelBias.offset), 1e-12);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Eigen::MatrixXd(r.covariance));
+    EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace swarmlio

@@ -23,7 +23,9 @@ TEST(Manifest, ReadsDronesPresetsAndOverrides) {
       "  - name: b\n"
       "    bag: /abs/b.bag\n"
       "    sensor_preset: " + kPresets + "livox_mid360.yaml\n"
-      "    bag_topics: {imu_topic: /mavros/imu/data}\n";
+      "    bag_topics: {imu_topic: /mavros/imu/data}\n"
+      "    start_offset_s: 20\n"
+      "    odometry: {initialization: in_flight, in_flight: {passes: 2}}\n";
   SwarmManifest m;
   const Status status = ParseManifest(yaml, "/data/run/swarm.yaml", &m);
   ASSERT_TRUE(status.ok()) << status.message();
@@ -43,6 +45,11 @@ TEST(Manifest, ReadsDronesPresetsAndOverrides) {
   EXPECT_EQ(m.drones[1].ground_truth_path, "");
   EXPECT_EQ(m.drones[1].bag.imu_topic, "/mavros/imu/data");
   EXPECT_EQ(m.drones[1].odometry.map.leaf_size_m, 0.3);
+  EXPECT_EQ(m.drones[0].start_offset_s, 0.0);
+  EXPECT_EQ(m.drones[0].odometry.initialization, lio::InitializationMode::kStatic);
+  EXPECT_EQ(m.drones[1].start_offset_s, 20.0);
+  EXPECT_EQ(m.drones[1].odometry.initialization, lio::InitializationMode::kInFlight);
+  EXPECT_EQ(m.drones[1].odometry.in_flight.passes, 2);
 }
 
 TEST(Manifest, RejectsBadEntriesWithFileLineAndKey) {
@@ -57,6 +64,10 @@ TEST(Manifest, RejectsBadEntriesWithFileLineAndKey) {
       {"drones:\n  - {name: a, bag: x.bag, odometry: {min_scan_pointz: 3}}\n", "min_scan_pointz"},
       {"drones:\n  - {name: a, bag: x.bag, odometry: {min_scan_points: -3}}\n", "min_scan_points"},
       {"drones:\n  - {name: a, bag: x.bag, sensor_preset: /no/such.yaml}\n", "sensor_preset"},
+      {"drones:\n  - {name: a, bag: x.bag, start_offset_s: -1}\n", "start_offset_s"},
+      {"drones:\n  - {name: a, bag: x.bag, odometry: {initialization: flying}}\n",
+       "initialization"},
+      {"drones:\n  - {name: a, bag: x.bag, odometry: {in_flight: {passes: 0}}}\n", "passes"},
   };
   for (const Bad& c : cases) {
     SwarmManifest m;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "swarmlio/math/so3.h"
@@ -164,6 +165,70 @@ TEST(TeammateDetector, TrackerFollowsOdometryWhenNotSeenAndAcceptsARefinedExtrin
   Eigen::Isometry3d T;
   ASSERT_TRUE(detector.GlobalExtrinsic(1, &T));
   EXPECT_TRUE(T.isApprox(T_true));
+}
+
+// j reboots at scan 200 (its new G_j is its pose then) and keeps flying in
+// view. RestartTeammate continues its track as a temporary tracker with the
+// positions already seen (G_i is unchanged), so the new session is matched
+// once it has min_pairs pairs (3 s of broadcasts); forgetting the tracker
+// instead needs a new excitation of a fresh track first.
+int ScansToReidentify(bool restart, Eigen::Isometry3d* T_Gi_Gj_new) {
+  const World world;
+  TeammateDetector detector(0, TeammateDetectorOptions());
+  std::mt19937_64 rng(11);
+  ScanResult result;
+  constexpr int kReboot = 200;
+  // G_j after the reboot: j's pose then (yaw only, as a level start).
+  const double t_reboot = 0.1 * kReboot;
+  const Eigen::Isometry3d T_W_Gj2 = Pose(Eigen::Vector3d(0, 0, 0.7), world.p_bj_in_W(t_reboot));
+  int identified_at = -1;
+  for (int k = 1; k <= 500; ++k) {
+    const double t = 0.1 * k;
+    const bool rebooted = k > kReboot;
+    if (k == kReboot + 1) {
+      EXPECT_EQ(detector.IdentifiedTeammates(), std::vector<int>{1});
+      if (restart) {
+        EXPECT_TRUE(detector.RestartTeammate(1, 500.0 + t));
+        EXPECT_EQ(detector.num_temporary_trackers(), 1);
+      } else {
+        EXPECT_TRUE(detector.ForgetTeammate(1));
+      }
+    }
+    detector.AddTeammateOdometry(Broadcast(1, t, rebooted ? T_W_Gj2 : world.T_W_Gj,
+                                           world.p_bj_in_W(t), world.v_bj_in_W(t)));
+    const Eigen::Isometry3d T_bi_W = world.T_W_bi(t).inverse();
+    std::vector<ScanPoint> points;
+    const Eigen::Vector3d c = T_bi_W * world.p_bj_in_W(t);
+    AddBlob(c - 0.07 * c.normalized(), Eigen::Vector3d(0.03, 0.08, 0.025), 25, 230.f, &rng,
+            &points);
+    const Eigen::Isometry3d T_Gi_bi = world.T_W_Gi.inverse() * world.T_W_bi(t);
+    EXPECT_TRUE(detector.ProcessScan(500.0 + t, T_Gi_bi, points, &result).ok());
+    if (rebooted && identified_at < 0 && !result.identifications.empty()) {
+      identified_at = k - kReboot;
+      const TeammateIdentification& id = result.identifications[0];
+      T_Gi_Gj_new->setIdentity();
+      T_Gi_Gj_new->linear() = id.R_Gi_Gj;
+      T_Gi_Gj_new->translation() = id.p_Gj_in_Gi;
+    }
+  }
+  const Eigen::Isometry3d T_true = world.T_W_Gi.inverse() * T_W_Gj2;
+  if (identified_at > 0) {
+    EXPECT_LT((T_Gi_Gj_new->translation() - T_true.translation()).norm(), 0.05);
+    EXPECT_LT(so3::Log(T_true.linear().transpose() * T_Gi_Gj_new->linear()).norm(),
+              1.0 * M_PI / 180);
+  }
+  return identified_at;
+}
+
+TEST(TeammateDetector, RestartedTeammateIsMatchedAgainFromTheKeptTrack) {
+  Eigen::Isometry3d T_restart, T_forget;
+  const int restart = ScansToReidentify(true, &T_restart);
+  const int forget = ScansToReidentify(false, &T_forget);
+  std::printf("[ figures  ] re-identified %d scans after the reboot with the kept track, %d "
+              "with a new one\n", restart, forget);
+  ASSERT_GT(restart, 0);
+  EXPECT_LE(restart, 40);  // min_pairs (30) broadcasts, matched every 0.5 s
+  EXPECT_TRUE(forget < 0 || forget > restart);
 }
 
 TEST(TeammateDetector, RejectsANonFinitePose) {

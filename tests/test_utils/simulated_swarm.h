@@ -22,11 +22,12 @@
 namespace swarmlio::testing {
 
 /// `scenario_path` simulated for `duration_s` seconds with 2 threads;
-/// `edit`, when given, changes the loaded scenario first.
+/// `edit`, when given, changes the loaded scenario first; with `true_G_in_W`
+/// each drone's true G in the simulation world fills R_W_G / p_G_in_W_m.
 inline ::testing::AssertionResult SimulateSwarm(
     const std::string& scenario_path, const std::string& name, double duration_s,
     const std::filesystem::path& dir, replay::SwarmManifest* manifest,
-    const std::function<void(sim::Scenario*)>& edit = nullptr) {
+    const std::function<void(sim::Scenario*)>& edit = nullptr, bool true_G_in_W = false) {
   sim::Scenario scenario;
   const Status loaded = sim::LoadScenario(scenario_path, &scenario);
   if (!loaded.ok()) return ::testing::AssertionFailure() << loaded.message();
@@ -59,6 +60,14 @@ inline ::testing::AssertionResult SimulateSwarm(
     manifest->drones.push_back(input);
   }
   sim::Simulator simulator(std::move(scenario.scene), scenario.drones, scenario.objects, config);
+  if (true_G_in_W) {
+    // The true G_i in the simulation world (the replay's swarm report uses it).
+    for (size_t i = 0; i < manifest->drones.size(); ++i) {
+      const sim::Pose T = simulator.T_W_G(static_cast<int>(i));
+      manifest->drones[i].R_W_G = T.R_W_b;
+      manifest->drones[i].p_G_in_W_m = T.p_b_in_W;
+    }
+  }
   std::vector<sim::DroneStats> stats;
   const Status ran = simulator.Run(sinks, &stats);
   if (!ran.ok()) return ::testing::AssertionFailure() << ran.message();

@@ -151,6 +151,8 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     std::printf("  IMU never initialized: %s\n", d.odometry().initialization_error().c_str());
   } else {
     std::printf("  IMU init: %s\n", d.odometry().initialization().Summary().c_str());
+    std::printf("  odometry initialized at sensor stamp %lld ns\n",
+                static_cast<long long>(d.odometry().initialization().stamp_ns));
     if (!d.odometry().initialization().sign_warning.empty()) {
       std::printf("  WARNING (IMU sign): %s\n",
                   d.odometry().initialization().sign_warning.c_str());

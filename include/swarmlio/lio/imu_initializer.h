@@ -170,6 +170,9 @@ struct ImuInitializerOptions {
 /// Result of a successful initialization.
 struct ImuInitialization {
   int64_t stamp_ns = 0;   // time of the state: the last sample of the window
+  // Sensor time at which the odometry started (its first outputs): stamp_ns
+  // at rest; in flight, the newest input when its last pass ended.
+  int64_t started_ns = 0;
   ImuSample last_sample;  // that sample, raw (the propagator's first input)
   EgoState state;         // R_G_b = I, p = v = 0, b_g, b_a = 0, g_in_G
   Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim> covariance =
@@ -191,6 +194,11 @@ struct ImuInitialization {
   /// Non-empty when the data contradict the configured sign (or auto could
   /// not decide): what was seen and the option to set. The caller shows it.
   std::string sign_warning;
+  // In-flight initialization (lio::Odometry with initialization: in_flight):
+  bool in_flight = false;         // velocity and gravity from the LiDAR alignment
+  int alignment_passes = 0;       // passes over the first scans that were run
+  int alignment_num_poses = 0;    // scan poses of the last pass used in the fit
+  double alignment_rms_m = 0.0;   // rms position residual of the last fit [m]
 
   /// One-line human-readable report (the library does not print it).
   std::string Summary() const;
@@ -215,6 +223,23 @@ class ImuInitializer {
   /// match the unit; the message names the measured values and thresholds.
   Status Initialize(ImuInitialization* result) const;
 
+  /// In-flight start (docs/imu.md "Initialization in flight"): the same unit
+  /// and sign logic on the window, no static test, and a coarse state for the
+  /// odometry's alignment passes: R_G_b = I, p = v = 0, b_g = b_a = 0 and
+  /// g_in_G = -s k mean(R_G_bk a_m,k) (each sample rotated into G by the
+  /// gyro integrated back from the window's end, so a turn does not smear
+  /// it), which still contains the mean acceleration of the flight. Only a
+  /// unit that makes |g| absurd (beyond +-50 % of nominal) is refused
+  /// (FailedPrecondition). The covariance comes from `coarse` (velocity and
+  /// gravity sigmas of the coarse guess, gyro-bias prior); the caller refines
+  /// velocity and gravity from LiDAR (lio/in_flight_alignment.h).
+  struct InFlightCoarseSigmas {
+    double velocity_m_s = 2.0;
+    double gravity_m_s2 = 2.0;
+    double gyro_bias_rad_s = 0.05;
+  };
+  Status InitializeInFlight(const InFlightCoarseSigmas& coarse, ImuInitialization* result) const;
+
   /// Empties the window (counters are kept).
   void Reset() { window_.clear(); }
 
@@ -227,6 +252,9 @@ class ImuInitializer {
  private:
   explicit ImuInitializer(const ImuInitializerOptions& options) : options_(options) {}
   int64_t DurationNs() const;
+  struct UnitAndSign;
+  // Steps 1 and 1b of Initialize(): the unit and the sign from the window mean.
+  Status DetermineUnitAndSign(const Eigen::Vector3d& mean_accel, UnitAndSign* out) const;
 
   ImuInitializerOptions options_;
   std::deque<ImuSample> window_;

@@ -19,7 +19,11 @@
 // solved; the output is the newest state and its marginal covariance.
 //
 // Before the first scan can be used the IMU must initialize from a static
-// window (ImuInitializer); scans before that are dropped and counted.
+// window (ImuInitializer); scans before that are dropped and counted. With
+// `initialization: in_flight` the drone may be moving: after the IMU window,
+// LiDAR passes over the first in_flight.probe_duration_s of scans fit the
+// initial velocity and gravity (in_flight_alignment.h); initialized() turns
+// true, and outputs come, once the last pass has started the odometry.
 // Threading: none inside; one instance per drone, not thread-safe.
 #pragma once
 
@@ -99,6 +103,9 @@ struct OdometryCounters {
   // The window back end only:
   int64_t window_restarts = 0;       // restarted from the propagator (IMU gap, failed factor)
   int64_t window_reintegrations = 0; // IMU factors preintegrated again at new biases
+  // initialization: in_flight only:
+  int64_t in_flight_passes = 0;      // alignment passes over the first scans
+  int64_t in_flight_restarts = 0;    // fits refused: the initialization started over
 };
 
 class Odometry {
@@ -154,6 +161,14 @@ class Odometry {
 
   Status ProcessReadyScans(bool flush);
   void SeedMapFromStaticStart(int64_t window_start_ns);
+  // In-flight initialization (odometry_in_flight.cc, docs/imu.md section 1b).
+  void StartInFlightProbe(const ImuInitialization& coarse);
+  // After a pass: fit v0 and g, then restart from t0 (another pass or the
+  // odometry proper), or start the initialization over when the fit fails.
+  void FinishInFlightPass();
+  // Map, window and propagator back to `start` at t0; the buffered IMU
+  // samples and scans queued again.
+  Status RestartFromInFlightStart(const ImuInitialization& start);
   Status ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush);
   // Steps 4-5 of ProcessScan with each back end: x, P in = the prediction,
   // out = the posterior (or the prediction when not updated).

@@ -9,6 +9,7 @@
 #include "swarmlio/lio/esikf_update.h"
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
+#include "swarmlio/lio/in_flight_init_options.h"
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/preprocess.h"
 #include "swarmlio/lio/scan_association.h"
@@ -21,7 +22,12 @@ struct OdometryOptions {
   /// The back end: the iterated filter update (default) or the fixed-lag
   /// window smoother (docs/window.md) over the same factors.
   EstimatorKind estimator = EstimatorKind::kFilter;
+  /// static (default): the start must be at rest (docs/imu.md section 1);
+  /// in_flight: velocity and gravity from LiDAR passes over the first scans
+  /// (section 1b), for a drone that joins or restarts while flying.
+  InitializationMode initialization = InitializationMode::kStatic;
   ImuInitializerOptions imu_init;
+  InFlightInitOptions in_flight;
   ImuPropagatorOptions propagation;
   PreprocessOptions preprocess;
   LocalMapOptions map;
@@ -40,7 +46,8 @@ struct OdometryOptions {
   int max_queued_scans = 20;
   /// Keep the registered (posterior, G frame) downsampled scan in each output.
   bool output_registered_scan = false;
-  /// Seed the map with the scans that lie wholly inside the static IMU
+  /// Seed the map (static initialization only) with the scans that lie
+  /// wholly inside the static IMU
   /// initialization window, at the initial pose (the window's static test
   /// shows the drone did not move). A narrow-FoV LiDAR's first scan alone is
   /// a sparse map whose plane fits tilt the first registrations (0.2 deg on
@@ -52,7 +59,11 @@ struct OdometryOptions {
     using config::FieldSpec;
     v("estimator", estimator,
       FieldSpec::Doc("back end: filter (iterated ESIKF) or window (fixed-lag smoother)"));
+    v("initialization", initialization,
+      FieldSpec::Doc("static (start at rest, default) or in_flight (velocity and gravity from "
+                     "the first LiDAR scans; for a late join or a restart while flying)"));
     v("imu_init", imu_init);
+    v("in_flight", in_flight);
     v("propagation", propagation);
     v("preprocess", preprocess);
     v("map", map);

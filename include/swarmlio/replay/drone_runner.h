@@ -104,6 +104,10 @@ class DroneRunner {
  private:
   DroneRunner() = default;
   Status ReadNext();
+  // The restart of DroneInput::restart_at_s: a new estimator, the records of
+  // the down time skipped, the outputs of the first session dropped.
+  Status Restart();
+  Status CreateEstimator(lio::InitializationMode initialization);
   void Collect();
   void Warn(const Status& status);
 
@@ -112,6 +116,9 @@ class DroneRunner {
   std::unique_ptr<swarm::DroneEstimator> estimator_;
   io::BagRecord next_;
   bool has_next_ = false;
+  bool fuse_ = true;
+  int drone_id_ = 0;
+  int64_t restart_ns_ = -1;  // pending restart: the log stamp (-1: none)
   std::vector<ScanRecord> scans_;
   std::vector<swarm::DroneOutput> outputs_;  // scratch
   std::vector<swarm::IdentificationEvent> identifications_;

@@ -14,6 +14,8 @@
 //       odometry: {imu_time_offset_s: 0.002}
 //       p_G_in_W_m: [0, 0, 0]           # optional, for plots: G in a common frame W
 //       q_W_G_xyzw: [0, 0, 0, 1]
+//       start_offset_s: 0               # optional: start this far into the log [s]
+//       restart_at_s: 0                 # optional: killed and restarted this far in [s]
 //
 // Odometry defaults follow the drone's LiDAR (lio::OdometryOptionsFor), then
 // the `odometry:` keys apply over them; the IMU initializer takes the
@@ -81,6 +83,19 @@ struct DroneInput {
   teammate::TeammateDetectorOptions teammate;  // YAML `teammate:` of the drone entry
   swarm::SwarmOptions swarm;                   // YAML `swarm:` of the drone entry
   TrueClock true_clock;                        // simulation truth, packet delivery only
+  /// The drone starts this long after its log's first record: every record
+  /// before is skipped (a late join or a restart mid-flight, as
+  /// LiveOptions::start_offset_s) [s]. Its G is then the IMU frame at its
+  /// (in-flight) initialization, not at the log's start.
+  double start_offset_s = 0.0;
+  /// A restart mid-flight (the process killed and started again): at this
+  /// time after the log's first record (0 = never) the drone's estimator is
+  /// dropped, the drone is down for restart_down_s, then a new estimator
+  /// (a new session, odometry.initialization = restart_initialization)
+  /// starts from the log there. Outputs: the second session only [s].
+  double restart_at_s = 0.0;
+  double restart_down_s = 1.0;  // [s]
+  lio::InitializationMode restart_initialization = lio::InitializationMode::kInFlight;
   /// Where the drone's global frame G lies in a common world frame W, only
   /// for drawing all drones in one top view (identity when unknown).
   Eigen::Matrix3d R_W_G = Eigen::Matrix3d::Identity();

@@ -95,7 +95,8 @@ struct DroneEstimatorCounters {
   int64_t passive_fused = 0;
   int64_t passive_repeated = 0;     // of passive_fused: sent again after the first message (lost)
   int64_t repeats_duplicate = 0;    // observations of this drone received twice: used once
-  int64_t extrinsics_stale = 0;     // teammates' T_Gj_Gi from before this session: ignored
+  // Ignored: T_Gj_Gi from before this session, T_Gj_Gk from before k restarted.
+  int64_t extrinsics_stale = 0;
   int64_t gravity_fused = 0;
   int64_t observations_rejected = 0;
   int64_t front_end_errors = 0;
@@ -158,6 +159,10 @@ class DroneEstimator : public lio::ScanStageHooks {
   // made after this drone's session began (by max_message_age_s): false
   // before the odometry initialized or the sender's clock offset is known.
   bool MadeInThisSession(int sender_id, int64_t sender_stamp_ns) const;
+  // Whether a sender's message (its clock) about teammate k is from k's
+  // current session (k restarted: not before this drone heard the new
+  // session + max_message_age_s); true when k never restarted.
+  bool MadeInSessionOf(int teammate_id, int sender_id, int64_t sender_stamp_ns) const;
 
   // Keeps the observations of the state message `m` that the next message
   // repeats (SwarmOptions::repeat_observations), moved into G_i.

@@ -116,6 +116,11 @@ class TeammateDetector {
   /// rebooted (new global frame) or was lost for good; it can be identified
   /// again from new broadcasts. False if nothing was known of it.
   bool ForgetTeammate(int drone_id);
+  /// The teammate rebooted (new G_j): as ForgetTeammate, but its tracker's
+  /// track goes on as a temporary tracker with the positions it saw (G_i
+  /// did not change), so the new session is matched as soon as it has
+  /// enough pairs, without a new excitation. `stamp_s`: now (own clock).
+  bool RestartTeammate(int drone_id, double stamp_s);
 
   int num_temporary_trackers() const { return static_cast<int>(temporary_.size()); }
   const std::vector<TemporaryTracker>& temporary_trackers() const { return temporary_; }

@@ -17,6 +17,7 @@
 #include "swarmlio/config/option_fields.h"
 #include "swarmlio/teammate/cv_filter.h"
 #include "swarmlio/teammate/odometry_history.h"
+#include "swarmlio/teammate/trajectory_buffer.h"
 
 namespace swarmlio::teammate {
 
@@ -52,8 +53,10 @@ struct TeammateTrackerOptions {
 class TeammateTracker {
  public:
   /// Takes over a temporary tracker's filter after identification.
+  /// `trajectory_capacity`: cluster positions kept (seen_trajectory()).
   TeammateTracker(int drone_id, int tracker_id, const Eigen::Matrix3d& R_Gi_Gj,
-                  const Eigen::Vector3d& p_Gj_in_Gi, const ConstantVelocityFilter& filter);
+                  const Eigen::Vector3d& p_Gj_in_Gi, const ConstantVelocityFilter& filter,
+                  int trajectory_capacity = 300);
 
   int drone_id() const { return drone_id_; }
   int tracker_id() const { return tracker_id_; }
@@ -85,6 +88,9 @@ class TeammateTracker {
 
   const ConstantVelocityFilter& filter() const { return filter_; }
   double last_lidar_update_s() const { return last_lidar_update_s_; }
+  /// The cluster positions of its LiDAR updates (G_i, newest last): when
+  /// the teammate restarts, a temporary tracker continues with them.
+  const TrajectoryBuffer& seen_trajectory() const { return seen_; }
 
  private:
   int drone_id_;
@@ -93,6 +99,7 @@ class TeammateTracker {
   Eigen::Vector3d p_Gj_in_Gi_;
   ConstantVelocityFilter filter_;
   double last_lidar_update_s_ = -1e300;
+  TrajectoryBuffer seen_;
 };
 
 }  // namespace swarmlio::teammate

@@ -36,6 +36,12 @@ class TemporaryTracker {
   TemporaryTracker(int id, double stamp_s, const Eigen::Vector3d& p_in_G,
                    const TemporaryTrackerOptions& options, int trajectory_capacity);
 
+  /// Continues the track of a teammate tracker whose teammate restarted
+  /// (TeammateDetector::RestartTeammate): its filter and the positions it
+  /// saw, at `stamp_s`.
+  TemporaryTracker(int id, double stamp_s, const ConstantVelocityFilter& filter,
+                   const TrajectoryBuffer& trajectory);
+
   /// Predicts to the measurement time and updates with a cluster position;
   /// the updated position joins the trajectory.
   void Update(double stamp_s, const Eigen::Vector3d& p_in_G, const TemporaryTrackerOptions& options);

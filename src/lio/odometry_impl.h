@@ -1,0 +1,72 @@
+// Internal: the state of lio::Odometry (odometry.cc) and of its in-flight
+// initialization (odometry_in_flight.cc). Not installed.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "swarmlio/lio/esikf_update.h"
+#include "swarmlio/lio/imu_initializer.h"
+#include "swarmlio/lio/imu_propagator.h"
+#include "swarmlio/lio/in_flight_alignment.h"
+#include "swarmlio/lio/local_map.h"
+#include "swarmlio/lio/odometry.h"
+#include "swarmlio/lio/preprocess.h"
+#include "swarmlio/lio/scan_association.h"
+#include "window_smoother.h"
+
+namespace swarmlio::lio {
+namespace internal {
+
+struct PendingScan {
+  LidarScan scan;
+  int64_t end_ns = 0;
+};
+
+// An in-flight initialization in progress (docs/imu.md section 1b): the data
+// since the start t0 are kept, and each pass runs the odometry over them
+// without the hooks and without outputs; its scan positions fit v0 and g.
+struct InFlightProbe {
+  bool active = false;
+  int pass = 0;                                         // passes finished
+  ImuInitialization start;                              // the current pass's initial state (at t0)
+  std::vector<ImuSample> imu;                           // every sample after t0
+  std::vector<PendingScan> scans;                       // every queued scan since t0
+  std::vector<StampedPosition> positions;               // the current pass's updated scans
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // its last posterior b_g
+  OdometryCounters counters;                            // the counters when the probe started
+};
+
+}  // namespace internal
+
+struct Odometry::Impl {
+  std::unique_ptr<ImuInitializer> initializer;
+  ImuInitialization initialization;
+  bool initialized = false;
+  std::unique_ptr<ImuPropagator> propagator;
+  std::unique_ptr<Preprocess> preprocess;
+  LocalMap map;
+  ScanAssociator associator;
+  EsikfUpdate update;
+  std::unique_ptr<internal::WindowSmoother> window;  // estimator: window
+  std::deque<ImuSample> imu_queue;                   // after initialization, not yet propagated
+  std::deque<internal::PendingScan> scan_queue;
+  std::deque<internal::PendingScan> static_start_scans;  // before initialization (map seeding)
+  internal::InFlightProbe probe;
+  std::vector<ScanOutput> outputs;
+  int64_t last_imu_stamp_ns = 0;
+  bool have_imu = false;
+  int64_t last_scan_end_ns = 0;
+  bool have_scan = false;
+  bool previous_degenerate = false;  // the last updated scan's flag (front end)
+  // Scratch reused between scans.
+  std::vector<PointXYZT> points_in_b;
+  std::vector<Eigen::Vector3d> undistorted;
+
+  Impl(const OdometryOptions& options)
+      : map(options.map), associator(&map, options.association), update(options.update) {}
+};
+
+}  // namespace swarmlio::lio

@@ -1,0 +1,248 @@
+// A drone that starts its estimator in flight (issue #13, faults B: a late
+// join or a restart mid-flight), offline and deterministic: indoor_3uav
+// (realistic imperfections, the scenario's seed) is simulated for 36 s and
+// replayed with uav3 (the Avia) starting 20 s into its log, during its
+// excitation flight (manifest start_offset_s). With the static initialization
+// it assumes rest while moving: its trajectory, in its G (the IMU frame at
+// its initialization), is several centimetres off and its teammates' extrinsics
+// of it are tilted by degrees. With initialization: in_flight (velocity and
+// gravity from LiDAR passes over its first scans) it tracks like a drone that
+// started at rest, and both teammates identify it within 15 s of its start
+// with a correct extrinsic (measured: 5.6 s, 2.1 cm / 0.66 deg and 2.5 cm /
+// 0.26 deg at the end). SWARMLIO_IN_FLIGHT_REFERENCE=1 also prints uav3 from
+// rest with each method. docs/imu.md section 1b, results.md.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "swarmlio/replay/swarm_replay.h"
+#include "test_utils/simulated_swarm.h"
+
+namespace swarmlio::replay {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kLateJoiner = 2;  // uav3, the Avia
+constexpr double kStartOffsetS = 20.0;
+constexpr double kDurationS = 36.0;
+
+// T_G_b of a ground-truth track at `stamp_ns` (linear position, slerp).
+bool PoseAt(const std::vector<PoseStamped>& track, int64_t stamp_ns, Eigen::Isometry3d* T) {
+  const auto it = std::lower_bound(track.begin(), track.end(), stamp_ns,
+                                   [](const PoseStamped& p, int64_t t) { return p.stamp_ns < t; });
+  if (it == track.begin() || it == track.end()) return false;
+  const PoseStamped& a = *(it - 1);
+  const PoseStamped& b = *it;
+  const double s =
+      static_cast<double>(stamp_ns - a.stamp_ns) / static_cast<double>(b.stamp_ns - a.stamp_ns);
+  T->setIdentity();
+  T->linear() = a.q_G_b.slerp(s, b.q_G_b).toRotationMatrix();
+  T->translation() = (1.0 - s) * a.p_b_in_G + s * b.p_b_in_G;
+  return true;
+}
+
+struct LateDroneFigures {
+  double position_rmse_m = 0.0;  // in its true G, no alignment
+  double init_delay_s = 0.0;     // from its first record to its initialization (t0)
+  double first_output_s = 0.0;   // from its first record to its first output
+  double init_tilt_deg = 0.0;    // initial gravity direction error
+  double init_velocity_error_m_s = 0.0;
+  double reference_rmse_m = 0.0;  // uav1, from a static start, same measure
+  // Per teammate (manifest order, the late drone's entry unused):
+  std::vector<double> identified_after_s;          // since its first record; < 0: never
+  std::vector<double> end_error_m, end_error_deg;  // the extrinsic at the end of the run
+};
+
+class InFlightStartTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() /
+                        ("swarmlio_in_flight_" + std::to_string(::getpid())));
+    fs::create_directories(*dir_);
+    manifest_ = new SwarmManifest();
+    ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
+        std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "indoor_3uav",
+        kDurationS, *dir_, manifest_, nullptr, /*true_G_in_W=*/true));
+  }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(*dir_, ec);
+    delete dir_;
+    delete manifest_;
+  }
+
+  // The drone `late` starts `offset_s` into its log with `mode`; with
+  // `restart` it starts at rest and is restarted there instead (down 1 s).
+  static LateDroneFigures Run(lio::InitializationMode mode,
+                              double offset_s = kStartOffsetS,
+                              int late = kLateJoiner,
+                              bool restart = false) {
+    SwarmManifest manifest = *manifest_;
+    DroneInput& input = manifest.drones[late];
+    if (restart) {
+      input.restart_at_s = offset_s;
+      input.restart_initialization = mode;
+    } else {
+      input.start_offset_s = offset_s;
+      input.odometry.initialization = mode;
+    }
+    std::unique_ptr<SwarmReplay> run;
+    EXPECT_TRUE(SwarmReplay::Create(manifest, &run).ok());
+    EXPECT_TRUE(run->Run(ReplayOptions()).ok());
+    LateDroneFigures f;
+    const DroneRunner& d = run->drone(late);
+    EXPECT_TRUE(d.odometry().initialized());
+    const std::vector<PoseStamped>& gt = d.bag_ground_truth();  // T_G0_b, G0 at the log start
+    const int64_t t0 = d.odometry().initialization().stamp_ns;
+    EXPECT_FALSE(gt.empty());
+    if (gt.empty()) return f;
+    // Its start: its first record, or its return after the restart.
+    const int64_t start_ns =
+        gt.front().stamp_ns +
+        (restart ? static_cast<int64_t>(std::llround((offset_s + input.restart_down_s) * 1e9)) : 0);
+    f.init_delay_s = 1e-9 * static_cast<double>(t0 - start_ns);
+    if (!d.scans().empty()) {
+      f.first_output_s = 1e-9 * static_cast<double>(d.scans().front().stamp_ns - start_ns);
+    }
+    Eigen::Isometry3d T_G0_G;  // its true G: the IMU pose at the initialization
+    EXPECT_TRUE(PoseAt(gt, t0, &T_G0_G));
+    {
+      // G0 is gravity-aligned (the log starts at rest, level).
+      const Eigen::Vector3d g_true = T_G0_G.linear().transpose() * Eigen::Vector3d(0, 0, -1);
+      const Eigen::Vector3d g_est = d.odometry().initialization().state.g_in_G.normalized();
+      f.init_tilt_deg = std::acos(std::clamp(g_true.dot(g_est), -1.0, 1.0)) * 180.0 / M_PI;
+      Eigen::Isometry3d a, b;
+      if (PoseAt(gt, t0 - 5'000'000, &a) && PoseAt(gt, t0 + 5'000'000, &b)) {
+        const Eigen::Vector3d v_true =
+            T_G0_G.linear().transpose() * (b.translation() - a.translation()) / 0.01;
+        f.init_velocity_error_m_s = (d.odometry().initialization().state.v_b_in_G - v_true).norm();
+      }
+    }
+    {
+      const DroneRunner& ref = run->drone(late == 0 ? 1 : 0);
+      double sse0 = 0.0;
+      int n0 = 0;
+      for (const ScanRecord& s : ref.scans()) {
+        Eigen::Isometry3d T;
+        if (!PoseAt(ref.bag_ground_truth(), s.stamp_ns, &T)) continue;
+        sse0 += (s.state.p_b_in_G - T.translation()).squaredNorm();
+        ++n0;
+      }
+      f.reference_rmse_m = std::sqrt(sse0 / std::max(n0, 1));
+    }
+    double sse = 0.0;
+    int n = 0;
+    for (const ScanRecord& s : d.scans()) {
+      Eigen::Isometry3d T_G0_b;
+      if (!PoseAt(gt, s.stamp_ns, &T_G0_b)) continue;
+      sse += (s.state.p_b_in_G - (T_G0_G.inverse() * T_G0_b).translation()).squaredNorm();
+      ++n;
+    }
+    EXPECT_GT(n, 50);
+    f.position_rmse_m = std::sqrt(sse / std::max(n, 1));
+    // True T_Gi_Gj with the late drone's G.
+    const Eigen::Isometry3d T_W_Gj = manifest.drones[late].T_W_G() * T_G0_G;
+    f.identified_after_s.assign(manifest.drones.size(), -1.0);
+    f.end_error_m.assign(manifest.drones.size(), -1.0);
+    f.end_error_deg.assign(manifest.drones.size(), -1.0);
+    for (int i = 0; i < run->num_drones(); ++i) {
+      if (i == late) continue;
+      const DroneRunner& observer = run->drone(i);
+      for (const swarm::IdentificationEvent& e : observer.identifications()) {
+        // (after a restart: the identification of its new session)
+        const double after_s = 1e-9 * static_cast<double>(e.stamp_ns - start_ns);
+        if (e.drone_id == late && f.identified_after_s[i] < 0.0 && after_s > 0.0) {
+          f.identified_after_s[i] = after_s;
+        }
+      }
+      const Eigen::Isometry3d T_true = manifest.drones[i].T_W_G().inverse() * T_W_Gj;
+      for (auto s = observer.scans().rbegin(); s != observer.scans().rend(); ++s) {
+        const auto t = std::find_if(s->teammates.begin(), s->teammates.end(),
+                                    [&](const TeammateRecord& r) { return r.drone_id == late; });
+        if (t == s->teammates.end()) continue;
+        const Eigen::Isometry3d E = T_true.inverse() * t->T_Gi_Gj.T_Gi_Gj();
+        f.end_error_m[i] = E.translation().norm();
+        f.end_error_deg[i] = Eigen::AngleAxisd(E.linear()).angle() * 180.0 / M_PI;
+        break;
+      }
+    }
+    return f;
+  }
+
+  static fs::path* dir_;
+  static SwarmManifest* manifest_;
+};
+
+fs::path* InFlightStartTest::dir_ = nullptr;
+SwarmManifest* InFlightStartTest::manifest_ = nullptr;
+
+void Print(const char* label, const LateDroneFigures& f, int late = kLateJoiner) {
+  std::printf(
+      "[ figures  ] %s: uav%d initialized %.2f s after its start (first output %.2f s; "
+      "tilt %.3f deg, velocity %.3f m/s off), position RMSE in its true G %.4f m (a "
+      "teammate from rest: %.4f m)",
+      label, late + 1, f.init_delay_s, f.first_output_s, f.init_tilt_deg, f.init_velocity_error_m_s,
+      f.position_rmse_m, f.reference_rmse_m);
+  for (size_t i = 0; i < f.identified_after_s.size(); ++i) {
+    if (static_cast<int>(i) == late) continue;
+    std::printf("; uav%zu identified it after %.1f s (extrinsic at the end %.4f m / %.3f deg)",
+                i + 1, f.identified_after_s[i], f.end_error_m[i], f.end_error_deg[i]);
+  }
+  std::printf("\n");
+}
+
+TEST_F(InFlightStartTest, LateJoinerInitializedInFlightTracksAndIsIdentified) {
+  const LateDroneFigures at_rest = Run(lio::InitializationMode::kStatic);
+  const LateDroneFigures in_flight = Run(lio::InitializationMode::kInFlight);
+  Print("static", at_rest);
+  Print("in_flight", in_flight);
+  if (std::getenv("SWARMLIO_IN_FLIGHT_REFERENCE") != nullptr) {
+    Print("from rest, static", Run(lio::InitializationMode::kStatic, 0.0));
+    Print("from rest, in_flight", Run(lio::InitializationMode::kInFlight, 0.0));
+  }
+  // Measured: static 0.172 m (it initializes 8.9 s late, 0.18 m/s off),
+  // in_flight 0.016 m; uav3 from rest 0.015 m (SWARMLIO_IN_FLIGHT_REFERENCE=1).
+  EXPECT_GT(at_rest.position_rmse_m, 0.05);
+  EXPECT_LT(in_flight.position_rmse_m, 0.03);
+  EXPECT_LT(in_flight.first_output_s, 1.5);  // the IMU window (1 s), then from its first scan
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_GE(in_flight.identified_after_s[i], 0.0) << i;
+    EXPECT_LE(in_flight.identified_after_s[i], 15.0) << i;
+    EXPECT_LT(in_flight.end_error_m[i], 0.06) << i;
+    EXPECT_LT(in_flight.end_error_deg[i], 1.0) << i;
+  }
+}
+
+// A restart mid-flight (the faults-B restart, offline): uav2 starts at rest,
+// is killed 18 s into its log (its estimator dropped, down 1 s) and starts a
+// new session in flight. Its teammates drop it and identify it again. Before
+// the fix, they also took each other's T_Gk_G2 of its OLD session (broadcast
+// until the sender hears the new session) as a graph identification: uav3's
+// extrinsic of it was then off by its motion since its first start (1.9 m /
+// 11 deg on the 60 s run, restart at 30 s), with either initialization.
+TEST_F(InFlightStartTest, RestartedDroneIsIdentifiedAgainWithItsNewG) {
+  constexpr int kRestarted = 1;  // uav2 (Mid-360)
+  const LateDroneFigures f =
+      Run(lio::InitializationMode::kInFlight, 18.0, kRestarted, /*restart=*/true);
+  Print("restart, in_flight", f, kRestarted);
+  EXPECT_LT(f.position_rmse_m, 0.03);
+  for (int i : {0, 2}) {
+    EXPECT_GE(f.identified_after_s[i], 0.0) << i;
+    EXPECT_LE(f.identified_after_s[i], 15.0) << i;
+    EXPECT_LT(f.end_error_m[i], 0.06) << i;
+    EXPECT_LT(f.end_error_deg[i], 1.0) << i;
+  }
+}
+
+}  // namespace
+}  // namespace swarmlio::replay
