@@ -14,6 +14,9 @@ DEFINE_string(bag, "", "instead of --manifest: the drone's bag");
 DEFINE_string(sensor_preset, "", "with --bag (swarmlio_ros: alone): sensor preset (configs/*.yaml)");
 DEFINE_int32(drone_id, 0, "with --bag / --sensor_preset: the drone's swarm id (its index in the swarm)");
 DEFINE_string(name, "", "with --bag / --sensor_preset: the drone's name (default uav<drone_id + 1>)");
+DEFINE_string(initialization, "",
+              "static | in_flight: overrides the drone's odometry.initialization (a drone "
+              "starting while flying: in_flight); empty: the manifest's or preset's");
 DEFINE_string(key_file, "", "required: the swarm's pre-shared key, 64 hex digits "
                             "(head -c 32 /dev/urandom | xxd -p -c 64)");
 DEFINE_string(udp_mode, "multicast", "multicast | broadcast | unicast");
@@ -70,6 +73,20 @@ Status ParsePeers(const std::string& text, const replay::SwarmManifest& manifest
 
 }  // namespace
 
+namespace {
+
+/// --initialization overrides the drone's odometry.initialization.
+Status ApplyInitializationFlag(replay::DroneInput* drone) {
+  if (!FLAGS_initialization.empty() &&
+      !config::EnumFromString(FLAGS_initialization, &drone->odometry.initialization)) {
+    return Status::InvalidArgument("--initialization: '" + FLAGS_initialization +
+                                   "' is not static or in_flight");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status LoadDroneFromFlags(LiveInput input, replay::DroneInput* drone, int* drone_id,
                           replay::SwarmManifest* manifest) {
   if (!FLAGS_manifest.empty()) {
@@ -79,7 +96,7 @@ Status LoadDroneFromFlags(LiveInput input, replay::DroneInput* drone, int* drone
       if (manifest->drones[i].name == FLAGS_drone) {
         *drone = manifest->drones[i];
         *drone_id = static_cast<int>(i);
-        return Status::Ok();
+        return ApplyInitializationFlag(drone);
       }
     }
     return Status::NotFound("--drone=" + FLAGS_drone + ": not in " + FLAGS_manifest);
@@ -96,7 +113,7 @@ Status LoadDroneFromFlags(LiveInput input, replay::DroneInput* drone, int* drone
       replay::ManifestFromBags({FLAGS_bag}, FLAGS_sensor_preset, {name}, manifest));
   *drone = manifest->drones[0];
   *drone_id = FLAGS_drone_id;
-  return Status::Ok();
+  return ApplyInitializationFlag(drone);
 }
 
 Status UdpOptionsFromFlags(const replay::SwarmManifest& manifest, net::UdpOptions* udp) {

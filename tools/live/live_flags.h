@@ -21,6 +21,7 @@ DECLARE_string(bag);
 DECLARE_string(sensor_preset);
 DECLARE_int32(drone_id);
 DECLARE_string(name);
+DECLARE_string(initialization);
 DECLARE_string(key_file);
 DECLARE_string(udp_mode);
 DECLARE_int32(port);

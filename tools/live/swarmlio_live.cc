@@ -32,9 +32,6 @@
 
 DEFINE_double(rate, 1.0, "playback speed (1 = real time)");
 DEFINE_double(start_s, 0.0, "skip the log's first seconds (a drone joining late or restarting)");
-DEFINE_string(initialization, "",
-              "static | in_flight: overrides the drone's odometry.initialization (a drone "
-              "joining late or restarting while flying: in_flight); empty: the manifest's");
 DEFINE_double(start_at_unix_s, 0.0,
               "start the playback at this wall-clock time (UNIX seconds; 0: at once): processes "
               "started together play the same instant of their logs together");
@@ -67,11 +64,6 @@ int Main() {
   int drone_id = 0;
   Status status = LoadDroneFromFlags(LiveInput::kBag, &drone, &drone_id, &manifest);
   if (!status.ok()) return Fail(status);
-  if (!FLAGS_initialization.empty() &&
-      !config::EnumFromString(FLAGS_initialization, &drone.odometry.initialization)) {
-    return Fail(Status::InvalidArgument("--initialization: '" + FLAGS_initialization +
-                                        "' is not static or in_flight"));
-  }
   live::LiveSetup setup;
   status = SwarmKeyFromFlags(&setup.key);
   if (!status.ok()) return Fail(status);
