@@ -313,8 +313,8 @@ TEST(ClockSyncSimulation, SymmetricJitterNeedsManyExchanges) {
   EXPECT_LT(at_5hz.max_abs_ms, 3.0);
 }
 
-TEST(ClockSyncSimulation, AsymmetricPathIsBiasedByHalfTheAsymmetry) {
-  // 0 -> 1 takes 10 ms, 1 -> 0 takes 50 ms; the other links 5 ms both ways.
+/// 0 -> 1 takes 10 ms, 1 -> 0 takes 50 ms; the other links 5 ms both ways.
+NetworkOptions AsymmetricNetwork() {
   NetworkOptions network;
   network.seed = 3;
   LinkOverride forward, backward;
@@ -325,6 +325,11 @@ TEST(ClockSyncSimulation, AsymmetricPathIsBiasedByHalfTheAsymmetry) {
   backward.to_id = 0;
   backward.link.latency_mean_s = 0.050;
   network.links = {forward, backward};
+  return network;
+}
+
+TEST(ClockSyncSimulation, AsymmetricPathIsBiasedByHalfTheAsymmetry) {
+  const NetworkOptions network = AsymmetricNetwork();
   SyncSimulation sim(network, SwarmClocks(), Requests());
   sim.RunUntil(60 * kS);
   // Drone 0 asks 1: out 10 ms, back 50 ms: (10 - 50) / 2 = -20 ms. Drone 1
@@ -445,16 +450,7 @@ TEST(ClockSyncSimulation, StateEchoSymmetricJitter) {
 }
 
 TEST(ClockSyncSimulation, StateEchoAsymmetricPathIsBiasedByHalfTheAsymmetry) {
-  NetworkOptions network;
-  network.seed = 3;
-  LinkOverride forward, backward;
-  forward.from_id = 0;
-  forward.to_id = 1;
-  forward.link.latency_mean_s = 0.010;
-  backward.from_id = 1;
-  backward.to_id = 0;
-  backward.link.latency_mean_s = 0.050;
-  network.links = {forward, backward};
+  const NetworkOptions network = AsymmetricNetwork();
   SyncSimulation sim(network, SwarmClocks(), ClockSyncOptions());
   sim.RunUntil(30 * kS);
   EXPECT_NEAR(sim.Error(0, 1), -20.0 * kMs, 1.0 * kMs);
