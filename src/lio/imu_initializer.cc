@@ -251,6 +251,50 @@ Status ImuInitializer::DetermineUnitAndSign(const Eigen::Vector3d& mean_accel,
   return Status::Ok();
 }
 
+void ImuInitializer::StartResult(const UnitAndSign& us, double g_norm,
+                                 ImuInitialization* r) const {
+  *r = ImuInitialization();
+  r->stamp_ns = window_.back().stamp_ns;
+  r->started_ns = r->stamp_ns;
+  r->last_sample = window_.back();
+  r->state = EgoState();
+  r->acceleration_unit = us.unit;
+  r->unit_detected = us.detected;
+  r->acceleration_to_m_s2 = us.sign * us.unit_factor;
+  r->gravity_magnitude_m_s2 = g_norm;
+  r->num_samples = static_cast<int>(window_.size());
+  r->reported_direction = us.direction;
+  r->angle_to_up_axis_deg = us.angle_deg;
+  r->acceleration_sign = us.sign;
+  r->sign_detected = us.sign_detected;
+  r->sign_warning = us.sign_warning;
+}
+
+void ImuInitializer::SetInitialCovariance(double velocity_sigma, const Eigen::Matrix3d& P_gyro_bias,
+                                          const Eigen::Matrix3d& P_gravity_measured,
+                                          double gravity_sigma_floor,
+                                          Eigen::Matrix<double, ErrorStateLayout::kEgoDim,
+                                                        ErrorStateLayout::kEgoDim>* P) const {
+  // Pose and velocity priors; the gravity error equals the accelerometer-bias
+  // error (only g - b_a enters the specific force, docs/imu.md), so
+  // Cov(g, b_a) = Cov(b_a), plus what the mean measured and a floor.
+  P->setZero();
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const double sr = options_.initial_rotation_stddev_rad;
+  const double sp = options_.initial_position_stddev_m;
+  const double sba = options_.initial_accel_bias_stddev_m_s2;
+  const double sg = gravity_sigma_floor;
+  P->block<3, 3>(L::kRotation.offset, L::kRotation.offset) = sr * sr * I;
+  P->block<3, 3>(L::kPosition.offset, L::kPosition.offset) = sp * sp * I;
+  P->block<3, 3>(L::kVelocity.offset, L::kVelocity.offset) = velocity_sigma * velocity_sigma * I;
+  P->block<3, 3>(L::kGyroBias.offset, L::kGyroBias.offset) = P_gyro_bias;
+  P->block<3, 3>(L::kAccelBias.offset, L::kAccelBias.offset) = sba * sba * I;
+  P->block<3, 3>(L::kGravity.offset, L::kGravity.offset) =
+      sba * sba * I + P_gravity_measured + sg * sg * I;
+  P->block<3, 3>(L::kGravity.offset, L::kAccelBias.offset) = sba * sba * I;
+  P->block<3, 3>(L::kAccelBias.offset, L::kGravity.offset) = sba * sba * I;
+}
+
 Status ImuInitializer::Initialize(ImuInitialization* result) const {
   if (!WindowFull()) {
     std::ostringstream os;
@@ -269,14 +313,8 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   UnitAndSign us;
   SWARMLIO_RETURN_IF_ERROR(DetermineUnitAndSign(stats.mean_accel, &us));
   const AccelerationUnit unit = us.unit;
-  const bool detected = us.detected;
   const double unit_factor = us.unit_factor;
-  const SpecificForceDirection direction = us.direction;
-  const double angle_deg = us.angle_deg;
-  const int sign = us.sign;
-  const bool sign_detected = us.sign_detected;
-  const std::string& sign_warning = us.sign_warning;
-  const double factor = sign * unit_factor;
+  const double factor = us.sign * unit_factor;
 
   // 2. Static test on the window (standard deviations in SI units).
   const double gyro_std = std::sqrt(stats.cov_gyro.trace());
@@ -308,26 +346,11 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   // 4. State. G := the IMU frame at the last window sample.
   const double n = static_cast<double>(window_.size());
   ImuInitialization& r = *result;
-  r = ImuInitialization();
-  r.stamp_ns = window_.back().stamp_ns;
-  r.started_ns = r.stamp_ns;
-  r.last_sample = window_.back();
-  r.state = EgoState();
+  StartResult(us, g_norm, &r);
   r.state.gyro_bias = stats.mean_gyro;
-  r.state.accel_bias.setZero();
   r.state.g_in_G = -factor * stats.mean_accel;
-  r.acceleration_unit = unit;
-  r.unit_detected = detected;
-  r.acceleration_to_m_s2 = factor;
-  r.gravity_magnitude_m_s2 = g_norm;
-  r.num_samples = static_cast<int>(window_.size());
   r.gyro_stddev_rad_s = gyro_std;
   r.accel_stddev_m_s2 = accel_std;
-  r.reported_direction = direction;
-  r.angle_to_up_axis_deg = angle_deg;
-  r.acceleration_sign = sign;
-  r.sign_detected = sign_detected;
-  r.sign_warning = sign_warning;
 
   // 5. Covariance (docs/imu.md): pose/velocity floors, standard error of the
   // gyro mean, the b_a prior, and the gravity error. At rest (R = I)
@@ -335,24 +358,11 @@ Status ImuInitializer::Initialize(ImuInitialization* result) const {
   // g_hat - g = -b_a = b_a_hat - b_a: the errors of g and b_a are EQUAL (up to
   // the noise of the mean), hence Cov(g, b_a) = +Cov(b_a) and only their
   // difference, which the accelerometer measured, is known tightly.
-  auto& P = r.covariance;
-  P.setZero();
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  const double sr = options_.initial_rotation_stddev_rad;
-  const double sp = options_.initial_position_stddev_m;
-  const double sv = options_.initial_velocity_stddev_m_s;
   const double sbg = options_.gyro_bias_stddev_floor_rad_s;
-  const double sba = options_.initial_accel_bias_stddev_m_s2;
-  const double sg = options_.gravity_stddev_floor_m_s2;
-  P.block<3, 3>(L::kRotation.offset, L::kRotation.offset) = sr * sr * I;
-  P.block<3, 3>(L::kPosition.offset, L::kPosition.offset) = sp * sp * I;
-  P.block<3, 3>(L::kVelocity.offset, L::kVelocity.offset) = sv * sv * I;
-  P.block<3, 3>(L::kGyroBias.offset, L::kGyroBias.offset) = stats.cov_gyro / n + sbg * sbg * I;
-  P.block<3, 3>(L::kAccelBias.offset, L::kAccelBias.offset) = sba * sba * I;
-  P.block<3, 3>(L::kGravity.offset, L::kGravity.offset) =
-      sba * sba * I + unit_factor * unit_factor * stats.cov_accel / n + sg * sg * I;
-  P.block<3, 3>(L::kGravity.offset, L::kAccelBias.offset) = sba * sba * I;
-  P.block<3, 3>(L::kAccelBias.offset, L::kGravity.offset) = sba * sba * I;
+  SetInitialCovariance(options_.initial_velocity_stddev_m_s, stats.cov_gyro / n + sbg * sbg * I,
+                       unit_factor * unit_factor * stats.cov_accel / n,
+                       options_.gravity_stddev_floor_m_s2, &r.covariance);
   return Status::Ok();
 }
 
@@ -394,42 +404,13 @@ Status ImuInitializer::InitializeInFlight(const InFlightCoarseSigmas& coarse,
     return Status::FailedPrecondition(os.str());
   }
   ImuInitialization& r = *result;
-  r = ImuInitialization();
-  r.stamp_ns = window_.back().stamp_ns;
-  r.started_ns = r.stamp_ns;
-  r.last_sample = window_.back();
-  r.state = EgoState();
+  StartResult(us, g_norm, &r);
   r.state.g_in_G = -factor * mean_in_G;
-  r.acceleration_unit = us.unit;
-  r.unit_detected = us.detected;
-  r.acceleration_to_m_s2 = factor;
-  r.gravity_magnitude_m_s2 = g_norm;
-  r.num_samples = n;
-  r.reported_direction = us.direction;
-  r.angle_to_up_axis_deg = us.angle_deg;
-  r.acceleration_sign = us.sign;
-  r.sign_detected = us.sign_detected;
-  r.sign_warning = us.sign_warning;
   r.in_flight = true;
 
-  auto& P = r.covariance;
-  P.setZero();
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  const double sr = options_.initial_rotation_stddev_rad;
-  const double sp = options_.initial_position_stddev_m;
-  const double sv = coarse.velocity_m_s;
   const double sbg = coarse.gyro_bias_rad_s;
-  const double sba = options_.initial_accel_bias_stddev_m_s2;
-  const double sg = coarse.gravity_m_s2;
-  P.block<3, 3>(L::kRotation.offset, L::kRotation.offset) = sr * sr * I;
-  P.block<3, 3>(L::kPosition.offset, L::kPosition.offset) = sp * sp * I;
-  P.block<3, 3>(L::kVelocity.offset, L::kVelocity.offset) = sv * sv * I;
-  P.block<3, 3>(L::kGyroBias.offset, L::kGyroBias.offset) = sbg * sbg * I;
-  P.block<3, 3>(L::kAccelBias.offset, L::kAccelBias.offset) = sba * sba * I;
-  // As at rest, only g - b_a enters the specific force: equal errors.
-  P.block<3, 3>(L::kGravity.offset, L::kGravity.offset) = (sba * sba + sg * sg) * I;
-  P.block<3, 3>(L::kGravity.offset, L::kAccelBias.offset) = sba * sba * I;
-  P.block<3, 3>(L::kAccelBias.offset, L::kGravity.offset) = sba * sba * I;
+  SetInitialCovariance(coarse.velocity_m_s, sbg * sbg * Eigen::Matrix3d::Identity(),
+                       Eigen::Matrix3d::Zero(), coarse.gravity_m_s2, &r.covariance);
   return Status::Ok();
 }
 

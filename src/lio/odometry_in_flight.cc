@@ -10,6 +10,23 @@ namespace {
 
 using L = ErrorStateLayout;
 
+// The counters as they were before the probe's passes (which leave no trace),
+// with the input counters and the in-flight ones of `now`.
+OdometryCounters ProbeCountersWithInput(const OdometryCounters& before_probe,
+                                        const OdometryCounters& now) {
+  OdometryCounters c = before_probe;
+  c.imu_samples = now.imu_samples;
+  c.imu_rejected = now.imu_rejected;
+  c.imu_out_of_order = now.imu_out_of_order;
+  c.scans = now.scans;
+  c.scans_empty = now.scans_empty;
+  c.scans_before_init = now.scans_before_init;
+  c.scans_dropped_queue = now.scans_dropped_queue;
+  c.in_flight_passes = now.in_flight_passes;
+  c.in_flight_restarts = now.in_flight_restarts;
+  return c;
+}
+
 // The initial state of the next pass from the fit: v0 and g with their
 // covariance, the coarse start's other blocks (rotation, position, gyro-bias
 // prior), and the b_a prior with the g - b_a correlation of a static start
@@ -80,16 +97,8 @@ void Odometry::FinishInFlightPass() {
   }
   if (!status.ok()) {
     // Start over: a new IMU window, then a new coarse start.
-    const OdometryCounters kept = counters_;
-    counters_ = probe.counters;
-    counters_.imu_samples = kept.imu_samples;
-    counters_.imu_rejected = kept.imu_rejected;
-    counters_.imu_out_of_order = kept.imu_out_of_order;
-    counters_.scans = kept.scans;
-    counters_.scans_empty = kept.scans_empty;
-    counters_.scans_before_init = kept.scans_before_init;
-    counters_.in_flight_passes = kept.in_flight_passes;
-    counters_.in_flight_restarts = kept.in_flight_restarts + 1;
+    counters_ = ProbeCountersWithInput(probe.counters, counters_);
+    ++counters_.in_flight_restarts;
     probe = internal::InFlightProbe();
     im.initialized = false;
     im.imu_queue.clear();
@@ -121,17 +130,7 @@ void Odometry::FinishInFlightPass() {
   }
   // The odometry proper starts: the probe's processing leaves no trace in
   // the counters (its input counters stay).
-  const OdometryCounters kept = counters_;
-  counters_ = probe.counters;
-  counters_.imu_samples = kept.imu_samples;
-  counters_.imu_rejected = kept.imu_rejected;
-  counters_.imu_out_of_order = kept.imu_out_of_order;
-  counters_.scans = kept.scans;
-  counters_.scans_empty = kept.scans_empty;
-  counters_.scans_before_init = kept.scans_before_init;
-  counters_.scans_dropped_queue = kept.scans_dropped_queue;
-  counters_.in_flight_passes = kept.in_flight_passes;
-  counters_.in_flight_restarts = kept.in_flight_restarts;
+  counters_ = ProbeCountersWithInput(probe.counters, counters_);
   im.initialization = next;
   im.initialization.started_ns = im.last_imu_stamp_ns;  // the newest input
   probe = internal::InFlightProbe();

@@ -255,6 +255,15 @@ class ImuInitializer {
   struct UnitAndSign;
   // Steps 1 and 1b of Initialize(): the unit and the sign from the window mean.
   Status DetermineUnitAndSign(const Eigen::Vector3d& mean_accel, UnitAndSign* out) const;
+  // The fields both starts share: stamps, unit, sign, |g|, a default state.
+  void StartResult(const UnitAndSign& us, double g_norm, ImuInitialization* r) const;
+  // The initial covariance of both starts: the options' pose and accel-bias
+  // priors, the given velocity sigma and gyro-bias block, and gravity with
+  // the b_a prior (fully correlated), what the mean measured, and a floor.
+  void SetInitialCovariance(
+      double velocity_sigma, const Eigen::Matrix3d& P_gyro_bias,
+      const Eigen::Matrix3d& P_gravity_measured, double gravity_sigma_floor,
+      Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>* P) const;
 
   ImuInitializerOptions options_;
   std::deque<ImuSample> window_;
