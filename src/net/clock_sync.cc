@@ -3,6 +3,7 @@
 #include "swarmlio/net/clock_sync.h"
 
 #include <algorithm>
+#include <tuple>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -351,26 +352,39 @@ void ClockSync::NoteTeammateState(const EgoStateMessage& state, int64_t arrival_
   }
 }
 
-void ClockSync::EchoesFor(int64_t now_ns, std::vector<StateEcho>* echoes) {
-  if (!echo_mode()) return;
+bool ClockSync::Settled(const Teammate& teammate, int64_t now_ns) const {
+  if (options_.settled_std_s <= 0.0) return true;
+  const ClockOffsetEstimate e = teammate.estimator.Estimate(now_ns);
+  return e.converged && e.std_ns <= options_.settled_std_s * 1e9;
+}
+
+void ClockSync::EchoesFor(int64_t now_ns, int max_echoes, EchoSelection selection,
+                          std::vector<StateEcho>* echoes) {
+  const int room = std::min(max_echoes, options_.max_echoes_per_state -
+                                            static_cast<int>(echoes->size()));
+  if (!echo_mode() || room <= 0) return;
   const int64_t max_age_ns = SecondsToNs(options_.max_echo_age_s);
   const int64_t period_ns = SecondsToNs(options_.echo_period_s);
-  std::vector<std::pair<uint64_t, int>> due;  // (echo order, id): least recently echoed first
+  const int64_t unsettled_period_ns = SecondsToNs(options_.unsettled_echo_period_s);
+  // (settled, echo order, id): unsettled first, then the least recently echoed.
+  std::vector<std::tuple<bool, uint64_t, int>> due;
   for (const auto& [id, teammate] : teammates_) {
     if (!teammate.state_to_echo) continue;
     const int64_t age_ns = now_ns - teammate.state_arrival_ns;
     if (age_ns < 0 || age_ns > max_age_ns) continue;
-    if (teammate.last_echo_ns != std::numeric_limits<int64_t>::min() &&
-        now_ns - teammate.last_echo_ns < period_ns) {
-      continue;
+    const bool settled = Settled(teammate, now_ns);
+    if (!settled || selection == EchoSelection::kAll) {
+      const int64_t spacing_ns = settled ? period_ns : unsettled_period_ns;
+      if (teammate.last_echo_ns == std::numeric_limits<int64_t>::min() ||
+          now_ns - teammate.last_echo_ns >= spacing_ns) {
+        due.emplace_back(settled, teammate.echo_order, id);
+      }
     }
-    due.emplace_back(teammate.echo_order, id);
   }
   std::sort(due.begin(), due.end());
-  if (due.size() > static_cast<size_t>(options_.max_echoes_per_state)) {
-    due.resize(static_cast<size_t>(options_.max_echoes_per_state));
-  }
-  for (const auto& [last, id] : due) {
+  if (due.size() > static_cast<size_t>(room)) due.resize(static_cast<size_t>(room));
+  for (const auto& [settled, last, id] : due) {
+    (void)settled;
     (void)last;
     Teammate& teammate = teammates_.at(id);
     StateEcho echo;

@@ -60,6 +60,7 @@ Status DroneEstimator::Create(int self_id, const DroneEstimatorOptions& options,
   std::unique_ptr<DroneEstimator> out(new DroneEstimator(self_id, options, lidar));
   SWARMLIO_RETURN_IF_ERROR(lio::Odometry::Create(options.odometry, lidar, &out->odometry_));
   out->detector_ = std::make_unique<teammate::TeammateDetector>(self_id, options.teammate);
+  out->impl_->budget = BroadcastBudget(options.swarm.broadcast_budget);
   if (options.swarm.synchronize_clocks) {
     SWARMLIO_RETURN_IF_ERROR(
         net::ClockSync::Create(self_id, options.swarm.clock_sync, &out->impl_->clock_sync));
@@ -141,6 +142,12 @@ void DroneEstimator::PopMessages(std::vector<net::SwarmMessage>* messages) {
   std::vector<net::TimeSyncMessage> requests;
   im.clock_sync->DueRequests(im.now_ns, &requests);
   for (const net::TimeSyncMessage& r : requests) messages->push_back(r);
+  // TimeSync packets (exchange: requests) are not optional: paid whatever the credit.
+  for (const net::SwarmMessage& m : *messages) {
+    if (std::holds_alternative<net::TimeSyncMessage>(m)) {
+      im.budget.Spend(im.budget.WireBytes(net::TimeSyncPacketBytes()));
+    }
+  }
 }
 
 const net::ClockSync* DroneEstimator::clock_sync() const { return impl_->clock_sync.get(); }

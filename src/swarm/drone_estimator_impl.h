@@ -16,6 +16,7 @@
 #include "dead_reckoning.h"
 #include "observation_terms.h"
 #include "swarmlio/lio/undistortion.h"
+#include "swarmlio/swarm/broadcast_budget.h"
 #include "swarmlio/swarm/drone_estimator.h"
 #include "teammate_state.h"
 
@@ -45,6 +46,11 @@ struct DroneEstimator::Impl {
   std::map<int, internal::PendingMutual> mutual;  // by sender
   int64_t last_extrinsic_broadcast_ns = 0;
   bool broadcast_extrinsics_once = false;
+  // What leaves: a byte budget, and the order in which teammates' items
+  // share it (broadcast_budget.h).
+  BroadcastBudget budget;
+  SendRotation observation_rotation;
+  SendRotation extrinsic_rotation;
   std::deque<internal::PendingPassive> passive;
   internal::MutualObservationModel model;
   LidarScan selected;  // the raw points handed to the detector

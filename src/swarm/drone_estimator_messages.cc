@@ -221,39 +221,6 @@ Status DroneEstimator::AddMessage(const net::ReceivedMessage& received) {
   return Status::Ok();
 }
 
-void DroneEstimator::RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,
-                                       const Eigen::MatrixXd& P) {
-  Impl& im = *impl_;
-  const RepeatObservations policy = options_.swarm.repeat_observations;
-  if (policy == RepeatObservations::kNone) return;
-  // k's position in G_i and its covariance with the own pose's:
-  //   p = R z + p_b,  dp = R dz - R [z]x dtheta + dp_b.
-  const Eigen::Matrix3d R = x.ego.R_G_b();
-  const Segment rot = ErrorStateLayout::kRotation;
-  const Segment pos = ErrorStateLayout::kPosition;
-  const Eigen::Matrix3d P_tt = P.block<3, 3>(rot.offset, rot.offset);
-  const Eigen::Matrix3d P_pp = P.block<3, 3>(pos.offset, pos.offset);
-  const Eigen::Matrix3d P_tp = P.block<3, 3>(rot.offset, pos.offset);
-  im.repeat_stamp_ns = m.stamp_ns;
-  for (const net::TeammateObservation& o : m.observations) {
-    if (policy == RepeatObservations::kDegenerateTeammates) {
-      const auto it = im.teammates.find(o.observed_id);
-      if (it == im.teammates.end() || !it->second.have_message || !it->second.last.degenerated) {
-        continue;
-      }
-    }
-    const Eigen::Matrix3d A = -R * so3::Hat(o.p_bk_in_bj);
-    Eigen::Matrix3d C = R * o.cov_p_bk_in_bj * R.transpose() + A * P_tt * A.transpose() + P_pp +
-                        A * P_tp + P_tp.transpose() * A.transpose();
-    C = 0.5 * (C + C.transpose()).eval();
-    net::PastObservation r;
-    r.observed_id = o.observed_id;
-    r.p_bk_in_Gj = R * o.p_bk_in_bj + x.ego.p_b_in_G;
-    r.cov_p_bk_in_Gj = C;
-    if (r.p_bk_in_Gj.allFinite() && C.allFinite()) im.repeat.push_back(r);
-  }
-}
-
 void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState& x,
                                 const Eigen::MatrixXd& P) {
   Impl& im = *impl_;
@@ -286,93 +253,10 @@ void DroneEstimator::OnScanDone(const lio::ScanOutput& output, const SwarmState&
   im.parts.push_back(std::move(im.part));
   im.part = SwarmPart();
 
-  // The broadcast: this drone's state and what it saw of its teammates.
-  net::EgoStateMessage m;
-  m.sender_id = self_id_;
-  m.stamp_ns = t_k;
-  m.session_start_ns = odometry_->initialization().stamp_ns;
-  m.q_Gj_bj = x.ego.q_G_b.normalized();
-  m.p_bj_in_Gj = x.ego.p_b_in_G;
-  m.v_bj_in_Gj = x.ego.v_b_in_G;
-  m.omega_bj_in_bj = im.last_gyro - x.ego.gyro_bias;
-  const auto block = [&P](const Segment& s) {
-    return Eigen::Matrix3d(P.block<3, 3>(s.offset, s.offset));
-  };
-  m.cov_theta_Gj_bj = block(ErrorStateLayout::kRotation);
-  m.cov_p_bj_in_Gj = block(ErrorStateLayout::kPosition);
-  m.cov_v_bj_in_Gj = block(ErrorStateLayout::kVelocity);
-  m.degenerated = output.degenerate;
-  std::set<int> reported;
-  for (const teammate::TeammateObservation& o : im.detection.observations) {
-    if (static_cast<int>(m.observations.size()) >= net::EgoStateMessage::kMaxObservations) break;
-    if (o.drone_id == self_id_ || !reported.insert(o.drone_id).second) continue;
-    net::TeammateObservation n;
-    n.observed_id = o.drone_id;
-    n.p_bk_in_bj = o.p_bj_in_bi;
-    n.cov_p_bk_in_bj = o.covariance_m2;
-    m.observations.push_back(n);
-  }
-  im.detection.observations.clear();
-  // The previous scan's observations again, for receivers that lost them.
-  for (net::PastObservation& o : im.repeat) {
-    o.age_ns = t_k - im.repeat_stamp_ns;
-    if (o.age_ns <= 0 || net::PastObservationAgeCode(o.age_ns) > net::kPastObservationAgeMaxCode ||
-        !((o.p_bk_in_Gj - m.p_bj_in_Gj).array().abs() < 0.9 * net::kObservationPositionMaxM).all()) {
-      continue;
-    }
-    if (static_cast<int>(m.past_observations.size()) >= net::EgoStateMessage::kMaxPastObservations) {
-      break;
-    }
-    m.past_observations.push_back(o);
-  }
-  im.repeat.clear();
-  RememberForRepeat(m, x, P);
-  if (m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite()) {
-    if (im.clock_sync != nullptr) {
-      // Clock synchronisation in the broadcast: teammates' states echoed back
-      // (the send delay is set when the packet leaves, MessageChannel::Send).
-      im.clock_sync->EchoesFor(t_k, &m.echoes);
-      im.clock_sync->NoteOwnState(t_k);
-    }
-    im.messages.push_back(m);
-  }
-
-  // The own T_Gi_Gj estimates, every extrinsic_broadcast_period_s and right
-  // after a new identification (teammates use them to identify this drone).
-  const double period = options_.swarm.extrinsic_broadcast_period_s;
-  const bool new_block = !im.parts.back().identifications.empty();
-  if (period > 0.0 && x.layout().NumTeammates() > 0 &&
-      (new_block || !im.broadcast_extrinsics_once ||
-       Seconds(t_k - im.last_extrinsic_broadcast_ns) >= period)) {
-    std::vector<net::GlobalExtrinsicEntry> entries;
-    for (int id : x.layout().teammate_ids()) {
-      net::GlobalExtrinsicEntry e;
-      e.teammate_id = id;
-      e.source = im.teammates[id].via_graph ? net::ExtrinsicSource::kGraph
-                                            : net::ExtrinsicSource::kTrajectoryMatch;
-      e.q_Gi_Gj = x.teammate(id).q_Gi_Gj.normalized();
-      e.p_Gj_in_Gi = x.teammate(id).p_Gj_in_Gi;
-      const Segment b = x.layout().TeammateBlock(id);
-      e.covariance = P.block<6, 6>(b.offset, b.offset);
-      e.covariance = 0.5 * (e.covariance + e.covariance.transpose()).eval();
-      if (e.q_Gi_Gj.coeffs().allFinite() && e.p_Gj_in_Gi.allFinite() && e.covariance.allFinite()) {
-        entries.push_back(e);
-      }
-    }
-    const Segment gravity = ErrorStateLayout::kGravity;
-    Eigen::Matrix3d cov_g = P.block<3, 3>(gravity.offset, gravity.offset);
-    cov_g = 0.5 * (cov_g + cov_g.transpose()).eval();
-    const Eigen::Vector3d g = x.ego.g_in_G.allFinite() && cov_g.allFinite()
-                                  ? x.ego.g_in_G
-                                  : Eigen::Vector3d::Zero();
-    if (!cov_g.allFinite()) cov_g.setZero();
-    for (net::GlobalExtrinsicMessage& g_msg :
-         net::SplitGlobalExtrinsics(self_id_, t_k, entries, g, cov_g)) {
-      im.messages.push_back(std::move(g_msg));
-    }
-    im.last_extrinsic_broadcast_ns = t_k;
-    im.broadcast_extrinsics_once = true;
-  }
+  // A teammate whose block went (lost or restarted) is new again when it is
+  // identified again: its T_Gi_Gj entry goes out at once.
+  for (int id : im.parts.back().removed) im.extrinsic_rotation.Forget(id);
+  Broadcast(output, x, P);
 }
 
 }  // namespace swarmlio::swarm

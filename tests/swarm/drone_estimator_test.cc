@@ -11,7 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
+#include <map>
 #include <cstdio>
 #include <deque>
 #include <random>
@@ -210,9 +213,18 @@ class ObserverSink : public sim::DroneSink {
     std::vector<net::SwarmMessage> sent;
     estimator_->PopMessages(&sent);
     for (const net::SwarmMessage& m : sent) {
-      if (std::holds_alternative<net::EgoStateMessage>(m)) ++ego_states_sent;
+      if (const auto* e = std::get_if<net::EgoStateMessage>(&m)) {
+        ++ego_states_sent;
+        observations_sent += static_cast<int>(e->observations.size());
+        wire_bytes.emplace_back(e->stamp_ns, kIpUdpBytes + net::EgoStatePacketBytes(
+                                                               e->observations.size(),
+                                                               e->past_observations.size(),
+                                                               e->echoes.size()));
+      }
       if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&m)) {
         ++extrinsic_messages_sent;
+        wire_bytes.emplace_back(g->stamp_ns,
+                                kIpUdpBytes + net::GlobalExtrinsicPacketBytes(g->entries.size()));
         for (const net::GlobalExtrinsicEntry& e : g->entries) {
           if (e.teammate_id == relayed_id) {
             ++graph_entries_sent;
@@ -227,7 +239,10 @@ class ObserverSink : public sim::DroneSink {
 
   std::vector<DroneOutput> outputs;
   std::vector<PoseStamped> ground_truth;
+  static constexpr size_t kIpUdpBytes = 28;
   int ego_states_sent = 0;          // one per scan
+  int observations_sent = 0;        // in the states
+  std::vector<std::pair<int64_t, size_t>> wire_bytes;  // (stamp, bytes on the wire) per message
   int extrinsic_messages_sent = 0;  // the own T_Gi_Gj, about once a second once identified
   double restart_at_s = 1e9;  // the teammate reboots then (new session_start)
   double mutual_at_s = 1e9;   // from then on the teammate sends its T_Gj_Gi (it identified us)
@@ -334,7 +349,8 @@ class ObserverSink : public sim::DroneSink {
 
 // The first `duration_s` of indoor_3uav for one observer fed by ObserverSink.
 struct ObserverRun {
-  ObserverRun(sim::Scenario scenario, double duration_s, int observer_id, int teammate)
+  ObserverRun(sim::Scenario scenario, double duration_s, int observer_id, int teammate,
+              const std::function<void(DroneEstimatorOptions*)>& adjust = {})
       : observer(observer_id) {
     sim::SimulationConfig config = scenario.simulation_config();
     config.duration_s = duration_s;
@@ -342,8 +358,10 @@ struct ObserverRun {
     drones = scenario.drones;
     simulator = std::make_unique<sim::Simulator>(std::move(scenario.scene), drones,
                                                  scenario.objects, config);
-    const Status created = DroneEstimator::Create(observer, OptionsFor(drones[observer]),
-                                                  drones[observer].lidar.sensor, &estimator);
+    DroneEstimatorOptions options = OptionsFor(drones[observer]);
+    if (adjust) adjust(&options);
+    const Status created =
+        DroneEstimator::Create(observer, options, drones[observer].lidar.sensor, &estimator);
     EXPECT_TRUE(created.ok()) << created.message();
     sink = std::make_unique<ObserverSink>(*simulator, observer, teammate, estimator.get());
   }
@@ -484,6 +502,61 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
       ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
   EXPECT_LT((last.teammates[0].T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm(), 0.03);
   EXPECT_EQ(run.estimator->counters().extrinsics_stale, 0);
+}
+
+// The most bytes sent in any window of `window_s` (messages by stamp).
+double MostBytesInWindow(std::vector<std::pair<int64_t, size_t>> sent, double window_s) {
+  std::sort(sent.begin(), sent.end());
+  double in_window = 0.0, most = 0.0;
+  size_t begin = 0;
+  for (size_t end = 0; end < sent.size(); ++end) {
+    in_window += static_cast<double>(sent[end].second);
+    while (sent[end].first - sent[begin].first >= static_cast<int64_t>(window_s * 1e9)) {
+      in_window -= static_cast<double>(sent[begin++].second);
+    }
+    most = std::max(most, in_window);
+  }
+  return most;
+}
+
+// The byte budget (swarm/broadcast_budget.h) bounds what leaves the drone
+// whatever it sees. Unlimited, the drone tracking its teammate sends more
+// than 1500 B in some second; with 1200 B/s every window of W seconds stays
+// within 1200 (W + burst_s), the state still goes out every scan, and the
+// observations are what gives (fewer, not none).
+TEST(DroneEstimator, KeepsItsBroadcastWithinTheByteBudget) {
+  const int observer = 0, teammate = 1;
+  constexpr double kBurstS = 0.2;  // a small credit: the rate binds within the 3.5 s
+  struct Sent {
+    std::vector<std::pair<int64_t, size_t>> wire_bytes;
+    int observations = 0;
+  };
+  std::map<double, Sent> sent;  // by max_bytes_per_s
+  for (double rate : {0.0, 1200.0}) {
+    ObserverRun run(IndoorScenario(), 12.5, observer, teammate, [rate](DroneEstimatorOptions* o) {
+      o->swarm.broadcast_budget.max_bytes_per_s = rate;
+      o->swarm.broadcast_budget.burst_s = kBurstS;
+      o->swarm.extrinsic_broadcast_period_s = 0.5;
+    });
+    run.sink->mutual_at_s = 9.0;  // identified then; observations from then on
+    ASSERT_TRUE(run.Run());
+    ASSERT_EQ(run.sink->ego_states_sent, static_cast<int>(run.sink->outputs.size()));
+    EXPECT_EQ(run.estimator->counters().identifications, 1) << rate;
+    sent[rate] = Sent{run.sink->wire_bytes, run.sink->observations_sent};
+  }
+  const Sent& unlimited = sent.at(0.0);
+  const Sent& limited = sent.at(1200.0);
+  EXPECT_GT(MostBytesInWindow(unlimited.wire_bytes, 1.0), 1500.0);
+  for (double window_s : {0.1, 1.0, 3.0}) {
+    EXPECT_LE(MostBytesInWindow(limited.wire_bytes, window_s), 1200.0 * (window_s + kBurstS))
+        << window_s;
+  }
+  std::printf("[ figures  ] observations sent %d unlimited, %d at 1200 B/s; most bytes in 1 s "
+              "%.0f / %.0f\n",
+              unlimited.observations, limited.observations,
+              MostBytesInWindow(unlimited.wire_bytes, 1.0), MostBytesInWindow(limited.wire_bytes, 1.0));
+  EXPECT_GT(limited.observations, 0);
+  EXPECT_LT(limited.observations, unlimited.observations);
 }
 
 // After a restart, teammates still broadcast their T_Gj_Gi of the previous

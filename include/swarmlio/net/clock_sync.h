@@ -76,7 +76,9 @@ namespace swarmlio::net {
 struct ClockSyncOptions {
   ClockExchange exchange = ClockExchange::kStateEcho;
   double echo_period_s = 0.2;        // state echo: each teammate's state echoed at most this
-                                     // often [s]
+                                     // often [s] ...
+  double unsettled_echo_period_s = 0.1;  // ... and this often while the offset to it is not
+                                         // settled (settled_std_s), e.g. after its restart [s]
   int max_echoes_per_state = 2;      // state echo: echoes per EgoState (bounds the bytes for
                                      // any swarm size)
   double max_echo_age_s = 0.4;       // state echo: a teammate state older than this when our
@@ -105,6 +107,9 @@ struct ClockSyncOptions {
                      "packets per teammate)"));
     v("echo_period_s", echo_period_s,
       FieldSpec::InRange(0.01, 3600.0, "s", "state echo: a teammate's state echoed at most this often"));
+    v("unsettled_echo_period_s", unsettled_echo_period_s,
+      FieldSpec::InRange(0.01, 3600.0, "s",
+                         "state echo: ... and this often while the offset is not settled"));
     v("max_echoes_per_state", max_echoes_per_state,
       FieldSpec::InRange(1, EgoStateMessage::kMaxEchoes, "", "state echo: echoes per EgoState"));
     v("max_echo_age_s", max_echo_age_s,
@@ -255,8 +260,20 @@ class ClockSync {
   /// The echoes for our state made at `now_ns`: teammates whose newest state
   /// is not echoed yet, arrived within max_echo_age_s and was last echoed
   /// echo_period_s ago or earlier; the least recently echoed first, at most
-  /// max_echoes_per_state.
-  void EchoesFor(int64_t now_ns, std::vector<StateEcho>* echoes);
+  /// max_echoes_per_state. A teammate whose offset (this drone's estimate;
+  /// the link is the same both ways, so the teammate's estimate of ours is
+  /// about as good) is not settled (settled_std_s) is due after
+  /// unsettled_echo_period_s instead, and comes first.
+  void EchoesFor(int64_t now_ns, std::vector<StateEcho>* echoes) {
+    EchoesFor(now_ns, options_.max_echoes_per_state, EchoSelection::kAll, echoes);
+  }
+  /// The same, at most max_echoes (what the sender's byte budget affords; the
+  /// others stay due) and, with kUnsettled, only teammates not settled (a
+  /// sender that ranks those above other content asks for them first). The
+  /// echoes already in *echoes count against max_echoes_per_state.
+  enum class EchoSelection { kAll, kUnsettled };
+  void EchoesFor(int64_t now_ns, int max_echoes, EchoSelection selection,
+                 std::vector<StateEcho>* echoes);
 
   /// Requests only (none with exchange = state_echo):
   /// appends the requests due at `now_ns` (at most one per teammate, t1 =
@@ -307,6 +324,8 @@ class ClockSync {
   bool AddExchange(int64_t t1_ns, int64_t t2_ns, int64_t t3_ns, int64_t t4_ns,
                    int64_t stamp_step_ns, Teammate* teammate);
   bool echo_mode() const { return options_.exchange == ClockExchange::kStateEcho; }
+  /// The offset to the teammate at now_ns is converged with std <= settled_std_s.
+  bool Settled(const Teammate& teammate, int64_t now_ns) const;
 
   int self_id_;
   ClockSyncOptions options_;

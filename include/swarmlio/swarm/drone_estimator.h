@@ -100,6 +100,15 @@ struct DroneEstimatorCounters {
   int64_t gravity_fused = 0;
   int64_t observations_rejected = 0;
   int64_t front_end_errors = 0;
+  // What this drone broadcast, wire bytes by content (IP/UDP headers in the
+  // state's and the extrinsic broadcasts' shares), and the observations the
+  // byte budget left out (docs/swarm.md "Broadcast budget").
+  int64_t sent_state_bytes = 0;
+  int64_t sent_echo_bytes = 0;
+  int64_t sent_observation_bytes = 0;
+  int64_t sent_repeat_bytes = 0;
+  int64_t sent_extrinsic_bytes = 0;
+  int64_t observations_unsent = 0;
 };
 
 class DroneEstimator : public lio::ScanStageHooks {
@@ -164,6 +173,10 @@ class DroneEstimator : public lio::ScanStageHooks {
   // session + max_message_age_s); true when k never restarted.
   bool MadeInSessionOf(int teammate_id, int sender_id, int64_t sender_stamp_ns) const;
 
+  // The scan's broadcast (drone_estimator_broadcast.cc): the own state with
+  // what fits the byte budget of echoes, observations and repeats, and the
+  // own T_Gi_Gj estimates when new or due.
+  void Broadcast(const lio::ScanOutput& output, const SwarmState& x, const Eigen::MatrixXd& P);
   // Keeps the observations of the state message `m` that the next message
   // repeats (SwarmOptions::repeat_observations), moved into G_i.
   void RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,

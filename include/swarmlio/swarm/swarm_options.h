@@ -9,6 +9,7 @@
 
 #include "swarmlio/config/option_fields.h"
 #include "swarmlio/net/clock_sync.h"
+#include "swarmlio/swarm/broadcast_budget.h"
 
 namespace swarmlio::swarm {
 
@@ -117,8 +118,12 @@ struct SwarmOptions {
   /// T_Gj_Gk from a trajectory match) is added through T_Gi_Gj T_Gj_Gk
   /// without an own match (docs/swarm.md "Identification through teammates").
   bool graph_identification = true;
-  /// The own T_Gi_Gj estimates are broadcast this often (0 = never) [s].
+  /// The own T_Gi_Gj estimates are broadcast this often (0 = never) [s];
+  /// new ones at once. Entries per broadcast: broadcast_budget.
   double extrinsic_broadcast_period_s = 1.0;
+  /// The bytes this drone puts on the wire: a budget shared by the optional
+  /// content of its messages (docs/swarm.md "Broadcast budget").
+  BroadcastBudgetOptions broadcast_budget;
   /// Radius of the ball around each tracked object kept out of the map [m].
   double map_exclusion_radius_m = 0.5;
 
@@ -161,6 +166,8 @@ struct SwarmOptions {
       FieldSpec::Doc("add a teammate that a known teammate identified, through its T_Gj_Gk"));
     v("extrinsic_broadcast_period_s", extrinsic_broadcast_period_s,
       FieldSpec::AtLeast(0.0, "s", "broadcast the own T_Gi_Gj estimates this often (0 = never)"));
+    v("broadcast_budget", broadcast_budget,
+      FieldSpec::Doc("bytes on the wire per second and how the optional content shares them"));
     v("map_exclusion_radius_m", map_exclusion_radius_m,
       FieldSpec::Positive("m", "points this close to a tracked object stay out of the map"));
   }
