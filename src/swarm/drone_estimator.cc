@@ -29,6 +29,7 @@ using internal::ChainPassesThrough;
 using internal::ComposeExtrinsic;
 using internal::SetProvenance;
 using internal::FixedExtrinsicCost;
+using internal::HeardTeammates;
 using internal::Predict;
 using internal::PredictedTeammate;
 using internal::SwarmPart;
@@ -242,7 +243,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
     x->AddTeammate(id.drone_id, T);
     AppendCovarianceBlock(C, P);
     im.teammates[id.drone_id].last_seen_ns = t_k;
-    SetProvenance(false, true, {}, &im.teammates[id.drone_id]);
+    SetProvenance(false, {}, &im.teammates[id.drone_id]);
     IdentificationEvent event;
     event.drone_id = id.drone_id;
     event.stamp_ns = t_k;
@@ -272,9 +273,10 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       AppendCovarianceBlock(C, P);
       im.teammates[j].last_seen_ns = t_k;
       // The inverse of an edge j derived itself stays derived, through
-      // teammates j did not name: never composed.
+      // teammates j did not name: any teammate heard so far may be in its chain.
       const bool derived = pending.entry.source == net::ExtrinsicSource::kGraph;
-      SetProvenance(derived, !derived, {}, &im.teammates[j]);
+      SetProvenance(derived, derived ? HeardTeammates(im.teammates, j) : std::map<int, int64_t>(),
+                    &im.teammates[j]);
       IdentificationEvent event;
       event.drone_id = j;
       event.stamp_ns = t_k;
@@ -504,7 +506,7 @@ void DroneEstimator::AddTeammatesThroughTeammates(int64_t t_k, SwarmState* x, Ei
     through[c.via] = im.teammates[c.via].session_start_ns;
     TeammateInfo& info = im.teammates[k];
     info.last_seen_ns = t_k;
-    SetProvenance(true, true, std::move(through), &info);
+    SetProvenance(true, std::move(through), &info);
     IdentificationEvent event;
     event.drone_id = k;
     event.stamp_ns = t_k;

@@ -12,10 +12,8 @@ bool Finite(const net::EgoStateMessage& m) {
          m.cov_p_bj_in_Gj.allFinite() && m.cov_v_bj_in_Gj.allFinite();
 }
 
-void SetProvenance(bool via_graph, bool provenance_known, std::map<int, int64_t> derived_through,
-                   TeammateInfo* info) {
+void SetProvenance(bool via_graph, std::map<int, int64_t> derived_through, TeammateInfo* info) {
   info->via_graph = via_graph;
-  info->provenance_known = provenance_known;
   info->derived_through = std::move(derived_through);
   info->observations_fused = 0;
 }
@@ -23,6 +21,14 @@ void SetProvenance(bool via_graph, bool provenance_known, std::map<int, int64_t>
 int64_t SessionOf(const Teammates& teammates, int id) {
   const auto it = teammates.find(id);
   return it == teammates.end() ? 0 : it->second.session_start_ns;
+}
+
+std::map<int, int64_t> HeardTeammates(const Teammates& teammates, int except) {
+  std::map<int, int64_t> heard;
+  for (const auto& [id, info] : teammates) {
+    if (id != except && info.last_heard_ns > 0) heard[id] = info.session_start_ns;
+  }
+  return heard;
 }
 
 bool LeansOnTeammates(const TeammateInfo& info_j, const SwarmState& x, const Teammates& teammates) {
@@ -35,9 +41,7 @@ bool LeansOnTeammates(const TeammateInfo& info_j, const SwarmState& x, const Tea
 bool CanRelay(const TeammateInfo& info_j, const SwarmState& x, const Teammates& teammates,
               const SwarmOptions& options) {
   if (!info_j.via_graph) return true;
-  // The inverse of a teammate's derived entry: through whom is not known, so
-  // a loop could not be ruled out.
-  if (!options.graph_through_derived || !info_j.provenance_known) return false;
+  if (!options.graph_through_derived) return false;
   // Once the teammates it came through left (or restarted), its block is the
   // only link to j's side of the swarm, with the correlations the
   // composition gave it; own observations of j make it first-hand-like.

@@ -32,12 +32,9 @@ struct TeammateInfo {
   int64_t session_heard_ns = 0;
   bool via_graph = false;          // its block came through a teammate's T_Gj_Gk
   // Provenance of a derived block (via_graph): the teammates whose frames its
-  // chain T_Gi_Gv ... T_Gw_Gj passes through, each with the session it was
+  // chain T_Gi_Gv ... T_Gw_Gj may pass through, each with the session it was
   // in then (id -> session_start_ns). Empty for a first-hand block.
   std::map<int, int64_t> derived_through;
-  // The chain of a derived block is known (false for the inverse of a
-  // teammate's own derived entry: its sender did not say through whom).
-  bool provenance_known = true;
   // Own active and passive observations fused into its block since it was added.
   int observations_fused = 0;
   // j's clock stamps of the observations of this drone already taken (j
@@ -56,13 +53,17 @@ struct TeammateInfo {
 using Teammates = std::map<int, TeammateInfo>;
 
 /// A block was just added for this teammate: where it came from (a derived
-/// block's chain: the teammates it passes through, with their sessions; a
+/// block's chain: the teammates it may pass through, with their sessions; a
 /// first-hand one: none) and no own observations in it yet.
-void SetProvenance(bool via_graph, bool provenance_known, std::map<int, int64_t> derived_through,
-                   TeammateInfo* info);
+void SetProvenance(bool via_graph, std::map<int, int64_t> derived_through, TeammateInfo* info);
 
 /// The session a teammate is in now, as far as its messages told (0: none heard).
 int64_t SessionOf(const Teammates& teammates, int id);
+
+/// Every teammate heard so far but `except`, with its current session: the
+/// chain of the inverse of j's own derived entry, which j does not name (it
+/// composed it through teammates it had, and they broadcast too).
+std::map<int, int64_t> HeardTeammates(const Teammates& teammates, int except);
 
 /// j's derived block still hangs on a block of this state it was composed
 /// from: a teammate its chain passes through is in the state, in the session
@@ -71,8 +72,8 @@ bool LeansOnTeammates(const TeammateInfo& info_j, const SwarmState& x, const Tea
 
 /// Whether j's block may be composed with j's own matches T_Gj_Gk (the
 /// identification through teammates): a first-hand block always; a derived
-/// one (SwarmOptions::graph_through_derived) when its chain is known and it
-/// no longer leans on the teammates it came through, or when
+/// one (SwarmOptions::graph_through_derived) when it no longer leans on the
+/// teammates it came through, or when
 /// graph_derived_min_observations own observations of j were fused into it.
 bool CanRelay(const TeammateInfo& info_j, const SwarmState& x, const Teammates& teammates,
               const SwarmOptions& options);

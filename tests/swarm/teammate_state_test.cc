@@ -82,7 +82,7 @@ TEST(ComposeExtrinsic, AFlippedBlockIsCaught) {
 // i knows j first-hand and k only through j (session 1 of j). A derived k
 // may not relay while j is in the state in that session, may once j left or
 // restarted, or once enough own observations of k were fused; never when the
-// option is off or when its chain is unknown.
+// option is off.
 TEST(CanRelay, ADerivedTeammateRelaysOnceItNoLongerLeansOnItsIntermediary) {
   const int j = 1, k = 2;
   SwarmState x;
@@ -91,8 +91,8 @@ TEST(CanRelay, ADerivedTeammateRelaysOnceItNoLongerLeansOnItsIntermediary) {
   Teammates teammates;
   teammates[j].session_start_ns = 100;
   teammates[k].session_start_ns = 200;
-  SetProvenance(false, true, {}, &teammates[j]);
-  SetProvenance(true, true, {{j, 100}}, &teammates[k]);
+  SetProvenance(false, {}, &teammates[j]);
+  SetProvenance(true, {{j, 100}}, &teammates[k]);
   SwarmOptions options;
   options.graph_derived_min_observations = 20;
   EXPECT_TRUE(CanRelay(teammates[j], x, teammates, options));  // first-hand
@@ -110,10 +110,32 @@ TEST(CanRelay, ADerivedTeammateRelaysOnceItNoLongerLeansOnItsIntermediary) {
   EXPECT_TRUE(CanRelay(teammates[k], x, teammates, options));
   options.graph_through_derived = false;
   EXPECT_FALSE(CanRelay(teammates[k], x, teammates, options));
-  options.graph_through_derived = true;
-  // The inverse of a teammate's own derived entry: through whom is unknown.
-  SetProvenance(true, false, {}, &teammates[k]);
-  EXPECT_FALSE(CanRelay(teammates[k], x, teammates, options));
+}
+
+// The inverse of k's own derived entry (k does not say through whom): its
+// chain is taken as every other teammate heard, in their current sessions.
+TEST(HeardTeammates, StandsInForAnUnnamedChain) {
+  const int j = 1, k = 2, m = 3, silent = 4;
+  Teammates teammates;
+  teammates[j].session_start_ns = 100;
+  teammates[j].last_heard_ns = 5;
+  teammates[k].session_start_ns = 200;
+  teammates[k].last_heard_ns = 6;
+  teammates[m].session_start_ns = 300;
+  teammates[m].last_heard_ns = 7;
+  teammates[silent].last_seen_ns = 8;  // seen, never heard
+  const std::map<int, int64_t> chain = HeardTeammates(teammates, k);
+  EXPECT_EQ(chain, (std::map<int, int64_t>{{j, 100}, {m, 300}}));
+  SetProvenance(true, chain, &teammates[k]);
+  SwarmState x;
+  x.AddTeammate(j, GlobalExtrinsic());
+  x.AddTeammate(k, GlobalExtrinsic());
+  SwarmOptions options;
+  EXPECT_FALSE(CanRelay(teammates[k], x, teammates, options));  // j is still there
+  teammates[j].session_start_ns = 101;                           // j restarted
+  EXPECT_TRUE(CanRelay(teammates[k], x, teammates, options));
+  EXPECT_FALSE(ChainPassesThrough(teammates[k], j, teammates));
+  EXPECT_TRUE(ChainPassesThrough(teammates[k], m, teammates));
 }
 
 // k's block came through j: composing j through k is a loop while j is in
@@ -123,7 +145,7 @@ TEST(ChainPassesThrough, RefusesALoopThroughTheSameSessionOnly) {
   const int j = 1, k = 2, m = 3;
   Teammates teammates;
   teammates[j].session_start_ns = 100;
-  SetProvenance(true, true, {{j, 100}}, &teammates[k]);
+  SetProvenance(true, {{j, 100}}, &teammates[k]);
   EXPECT_TRUE(ChainPassesThrough(teammates[k], j, teammates));
   EXPECT_FALSE(ChainPassesThrough(teammates[k], m, teammates));
   teammates[j].session_start_ns = 101;
