@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <map>
 #include <memory>
 #include <cmath>
 #include <deque>
@@ -23,8 +24,12 @@
 namespace swarmlio::swarm {
 namespace {
 
+using internal::CanRelay;
+using internal::ChainPassesThrough;
 using internal::ComposeExtrinsic;
+using internal::SetProvenance;
 using internal::FixedExtrinsicCost;
+using internal::HeardTeammates;
 using internal::Predict;
 using internal::PredictedTeammate;
 using internal::SwarmPart;
@@ -245,7 +250,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
     x->AddTeammate(id.drone_id, T);
     AppendCovarianceBlock(C, P);
     im.teammates[id.drone_id].last_seen_ns = t_k;
-    im.teammates[id.drone_id].via_graph = false;
+    SetProvenance(false, {}, &im.teammates[id.drone_id]);
     IdentificationEvent event;
     event.drone_id = id.drone_id;
     event.stamp_ns = t_k;
@@ -274,8 +279,11 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       x->AddTeammate(j, T);
       AppendCovarianceBlock(C, P);
       im.teammates[j].last_seen_ns = t_k;
-      // The inverse of an edge j derived itself stays derived: never composed.
-      im.teammates[j].via_graph = pending.entry.source == net::ExtrinsicSource::kGraph;
+      // The inverse of an edge j derived itself stays derived, through
+      // teammates j did not name: any teammate heard so far may be in its chain.
+      const bool derived = pending.entry.source == net::ExtrinsicSource::kGraph;
+      SetProvenance(derived, derived ? HeardTeammates(im.teammates, j) : std::map<int, int64_t>(),
+                    &im.teammates[j]);
       IdentificationEvent event;
       event.drone_id = j;
       event.stamp_ns = t_k;
@@ -377,6 +385,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
         ++im.part.active;
         ++im.fused_by_teammate[o.drone_id].first;
         ++counters_.active_fused;
+        if (!frozen) ++it->second.observations_fused;
       }
     }
   }
@@ -411,6 +420,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       if (add(std::move(factor), p.from, e, S)) {
         ++im.part.passive;
         ++im.fused_by_teammate[p.from].second;
+        if (!frozen) ++im.teammates[p.from].observations_fused;
         ++counters_.passive_fused;
         if (p.repeated) ++counters_.passive_repeated;
       }
@@ -458,11 +468,14 @@ void DroneEstimator::AddTeammatesThroughTeammates(int64_t t_k, SwarmState* x, Ei
   std::map<int, Candidate> best;  // by k
   for (int j : x->layout().teammate_ids()) {
     const TeammateInfo& info_j = im.teammates[j];
-    if (info_j.via_graph) continue;  // only first-hand edges of first-hand teammates
+    // Only j's first-hand edges (identified), and only through a derived j
+    // that no longer leans on the teammates it came through.
+    if (!CanRelay(info_j, *x, im.teammates, so)) continue;
     const Segment bj = x->layout().TeammateBlock(j);
     const Eigen::Matrix<double, 6, 6> P_ij = P->block<6, 6>(bj.offset, bj.offset);
     for (const auto& [k, e] : info_j.identified) {
       if (k == self_id_ || x->HasTeammate(k)) continue;
+      if (ChainPassesThrough(info_j, k, im.teammates)) continue;
       const auto it_k = im.teammates.find(k);
       if (it_k != im.teammates.end() && it_k->second.restarted) continue;
       GlobalExtrinsic T_jk;
@@ -495,9 +508,12 @@ void DroneEstimator::AddTeammatesThroughTeammates(int64_t t_k, SwarmState* x, Ei
     AppendCovarianceBlock(C, P);
     P->block(n, 0, 6, n) = cross;
     P->block(0, n, n, 6) = cross.transpose();
+    // k's chain: j's (empty when j is first-hand) and j itself.
+    std::map<int, int64_t> through = im.teammates[c.via].derived_through;
+    through[c.via] = im.teammates[c.via].session_start_ns;
     TeammateInfo& info = im.teammates[k];
     info.last_seen_ns = t_k;
-    info.via_graph = true;
+    SetProvenance(true, std::move(through), &info);
     IdentificationEvent event;
     event.drone_id = k;
     event.stamp_ns = t_k;

@@ -1,5 +1,7 @@
 #include "teammate_state.h"
 
+#include <utility>
+
 #include "swarmlio/math/so3.h"
 
 namespace swarmlio::swarm::internal {
@@ -8,6 +10,48 @@ bool Finite(const net::EgoStateMessage& m) {
   return m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite() && m.v_bj_in_Gj.allFinite() &&
          m.omega_bj_in_bj.allFinite() && m.cov_theta_Gj_bj.allFinite() &&
          m.cov_p_bj_in_Gj.allFinite() && m.cov_v_bj_in_Gj.allFinite();
+}
+
+void SetProvenance(bool via_graph, std::map<int, int64_t> derived_through, TeammateInfo* info) {
+  info->via_graph = via_graph;
+  info->derived_through = std::move(derived_through);
+  info->observations_fused = 0;
+}
+
+int64_t SessionOf(const Teammates& teammates, int id) {
+  const auto it = teammates.find(id);
+  return it == teammates.end() ? 0 : it->second.session_start_ns;
+}
+
+std::map<int, int64_t> HeardTeammates(const Teammates& teammates, int except) {
+  std::map<int, int64_t> heard;
+  for (const auto& [id, info] : teammates) {
+    if (id != except && info.last_heard_ns > 0) heard[id] = info.session_start_ns;
+  }
+  return heard;
+}
+
+bool LeansOnTeammates(const TeammateInfo& info_j, const SwarmState& x, const Teammates& teammates) {
+  for (const auto& [v, session] : info_j.derived_through) {
+    if (x.HasTeammate(v) && SessionOf(teammates, v) == session) return true;
+  }
+  return false;
+}
+
+bool CanRelay(const TeammateInfo& info_j, const SwarmState& x, const Teammates& teammates,
+              const SwarmOptions& options) {
+  if (!info_j.via_graph) return true;
+  if (!options.graph_through_derived) return false;
+  // Once the teammates it came through left (or restarted), its block is the
+  // only link to j's side of the swarm, with the correlations the
+  // composition gave it; own observations of j make it first-hand-like.
+  return !LeansOnTeammates(info_j, x, teammates) ||
+         info_j.observations_fused >= options.graph_derived_min_observations;
+}
+
+bool ChainPassesThrough(const TeammateInfo& info_j, int k, const Teammates& teammates) {
+  const auto it = info_j.derived_through.find(k);
+  return it != info_j.derived_through.end() && it->second == SessionOf(teammates, k);
 }
 
 PredictedTeammate Predict(const net::EgoStateMessage& m, double dt) {

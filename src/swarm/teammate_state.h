@@ -12,6 +12,7 @@
 
 #include "swarmlio/net/messages.h"
 #include "swarmlio/state/swarm_state.h"
+#include "swarmlio/swarm/swarm_options.h"
 
 namespace swarmlio::swarm::internal {
 
@@ -30,17 +31,57 @@ struct TeammateInfo {
   // made before this + max_message_age_s are of its old G_j.
   int64_t session_heard_ns = 0;
   bool via_graph = false;          // its block came through a teammate's T_Gj_Gk
+  // Provenance of a derived block (via_graph): the teammates whose frames its
+  // chain T_Gi_Gv ... T_Gw_Gj may pass through, each with the session it was
+  // in then (id -> session_start_ns). Empty for a first-hand block.
+  std::map<int, int64_t> derived_through;
+  // Own active and passive observations fused into its block since it was added.
+  int observations_fused = 0;
   // j's clock stamps of the observations of this drone already taken (j
   // repeats observations, SwarmOptions::repeat_observations): the newest few.
   std::deque<int64_t> taken_observation_stamps;
   // j's own trajectory matches T_Gj_Gk, by k (from its GlobalExtrinsic
-  // broadcasts; kTrajectoryMatch entries only, so derived edges never chain).
+  // broadcasts; kTrajectoryMatch entries only: j's derived edges are never
+  // composed here, j cannot tell through whom it derived them).
   std::map<int, net::GlobalExtrinsicEntry> identified;
   // j's gravity in G_j from its newest GlobalExtrinsic message, fused once.
   bool gravity_pending = false;
   Eigen::Vector3d g_in_Gj = Eigen::Vector3d::Zero();
   Eigen::Matrix3d cov_g_in_Gj = Eigen::Matrix3d::Zero();
 };
+
+using Teammates = std::map<int, TeammateInfo>;
+
+/// A block was just added for this teammate: where it came from (a derived
+/// block's chain: the teammates it may pass through, with their sessions; a
+/// first-hand one: none) and no own observations in it yet.
+void SetProvenance(bool via_graph, std::map<int, int64_t> derived_through, TeammateInfo* info);
+
+/// The session a teammate is in now, as far as its messages told (0: none heard).
+int64_t SessionOf(const Teammates& teammates, int id);
+
+/// Every teammate heard so far but `except`, with its current session: the
+/// chain of the inverse of j's own derived entry, which j does not name (it
+/// composed it through teammates it had, and they broadcast too).
+std::map<int, int64_t> HeardTeammates(const Teammates& teammates, int except);
+
+/// j's derived block still hangs on a block of this state it was composed
+/// from: a teammate its chain passes through is in the state, in the session
+/// the chain used.
+bool LeansOnTeammates(const TeammateInfo& info_j, const SwarmState& x, const Teammates& teammates);
+
+/// Whether j's block may be composed with j's own matches T_Gj_Gk (the
+/// identification through teammates): a first-hand block always; a derived
+/// one (SwarmOptions::graph_through_derived) when it no longer leans on the
+/// teammates it came through, or when
+/// graph_derived_min_observations own observations of j were fused into it.
+bool CanRelay(const TeammateInfo& info_j, const SwarmState& x, const Teammates& teammates,
+              const SwarmOptions& options);
+
+/// j's chain passes through k's current frame: T_Gi_Gj T_Gj_Gk would close a
+/// loop (k's own edge counted twice, as if independent). A k that restarted
+/// since has a new frame, which the chain never used.
+bool ChainPassesThrough(const TeammateInfo& info_j, int k, const Teammates& teammates);
 
 // A teammate's broadcast state predicted to time t (own clock).
 struct PredictedTeammate {

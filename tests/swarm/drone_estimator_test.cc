@@ -231,6 +231,7 @@ class ObserverSink : public sim::DroneSink {
             EXPECT_EQ(e.source, net::ExtrinsicSource::kGraph);  // never relayed as first-hand
           } else {
             EXPECT_EQ(e.teammate_id, teammate_);
+            if (e.source == net::ExtrinsicSource::kGraph) ++teammate_graph_entries_sent;
           }
         }
       }
@@ -250,6 +251,16 @@ class ObserverSink : public sim::DroneSink {
   int gravity_messages_delivered = 0;  // GlobalExtrinsic messages with the teammate's gravity
   int relayed_id = -1;  // with mutual_at_s: the teammate also sends its own match of this drone
   int graph_entries_sent = 0;  // the observer's broadcasts of relayed_id
+  int teammate_graph_entries_sent = 0;  // ... of the teammate, as derived
+  // The teammate's G after its reboot: restart_shift T_Gj_W (before: T_Gj_W).
+  Eigen::Isometry3d restart_shift = Eigen::Isometry3d::Identity();
+  // With relayed_id: from then on the relayed drone sends its own match of
+  // the teammate (T_Gk_Gj, of the teammate's current G).
+  double relayed_match_at_s = 1e9;
+  // With relayed_id: the relayed drone, not the teammate, made the first
+  // edge: from mutual_at_s on it sends its own derived T_Gk_Gi (kGraph), and
+  // the teammate sends no match of it.
+  bool relayed_sends_derived = false;
 
  private:
   // Broadcasts of the teammate that arrived (20 ms after its scan end) by `now_ns`.
@@ -259,13 +270,15 @@ class ObserverSink : public sim::DroneSink {
            sim_.StampNs(observer_, broadcast_times_[next_] + latency_s) <= now_ns) {
       const double t = broadcast_times_[next_++];
       const sim::KinematicState s = sim_.drones()[static_cast<size_t>(teammate_)].trajectory.StateAt(t);
+      // The teammate's G in its current session.
+      const Eigen::Isometry3d T_Gj_W = t < restart_at_s ? T_Gj_W_ : restart_shift * T_Gj_W_;
       net::EgoStateMessage m;
       m.sender_id = teammate_;
       m.stamp_ns = sim_.StampNs(observer_, t);  // synchronised clocks
       m.session_start_ns = t < restart_at_s ? 1 : 2;
-      m.q_Gj_bj = Eigen::Quaterniond(T_Gj_W_.linear() * s.R_W_b).normalized();
-      m.p_bj_in_Gj = T_Gj_W_ * s.p_b_in_W;
-      m.v_bj_in_Gj = T_Gj_W_.linear() * s.v_b_in_W;
+      m.q_Gj_bj = Eigen::Quaterniond(T_Gj_W.linear() * s.R_W_b).normalized();
+      m.p_bj_in_Gj = T_Gj_W * s.p_b_in_W;
+      m.v_bj_in_Gj = T_Gj_W.linear() * s.v_b_in_W;
       m.omega_bj_in_bj = s.omega_b;
       m.cov_theta_Gj_bj = 1e-6 * Eigen::Matrix3d::Identity();
       m.cov_p_bj_in_Gj = 1e-5 * Eigen::Matrix3d::Identity();
@@ -306,8 +319,34 @@ class ObserverSink : public sim::DroneSink {
         net::ReceivedMessage rk = r;
         rk.message = mk;
         EXPECT_TRUE(estimator_->AddMessage(rk).ok());
+        net::GlobalExtrinsicMessage gk;
+        gk.sender_id = relayed_id;
+        gk.stamp_ns = m.stamp_ns;
+        // Truth, 1 cm / 0.2 deg sigma.
+        const auto entry = [](int id, const Eigen::Isometry3d& T, net::ExtrinsicSource source) {
+          net::GlobalExtrinsicEntry e;
+          e.teammate_id = id;
+          e.source = source;
+          e.q_Gi_Gj = Eigen::Quaterniond(T.linear()).normalized();
+          e.p_Gj_in_Gi = T.translation();
+          e.covariance.diagonal() << 1.2e-5, 1.2e-5, 1.2e-5, 1e-4, 1e-4, 1e-4;
+          return e;
+        };
+        if (relayed_sends_derived && t >= mutual_at_s) {
+          gk.entries.push_back(entry(observer_, T_Gk_W * ToIsometry(sim_.T_W_G(observer_)),
+                                     net::ExtrinsicSource::kGraph));
+        }
+        if (t >= relayed_match_at_s) {  // its own match of the teammate
+          gk.entries.push_back(
+              entry(teammate_, T_Gk_W * T_Gj_W.inverse(), net::ExtrinsicSource::kTrajectoryMatch));
+        }
+        if (!gk.entries.empty()) {
+          rk.message = gk;
+          EXPECT_TRUE(estimator_->AddMessage(rk).ok());
+        }
       }
-      if (t >= mutual_at_s) {
+      // The teammate's new session has not identified the observer.
+      if (t >= mutual_at_s && t < restart_at_s) {
         // The teammate's estimate of T_Gj_Gi: the truth, 1 cm / 0.2 deg sigma.
         const Eigen::Isometry3d T_Gj_Gi = T_Gj_W_ * ToIsometry(sim_.T_W_G(observer_));
         net::GlobalExtrinsicMessage g;
@@ -319,7 +358,7 @@ class ObserverSink : public sim::DroneSink {
         e.p_Gj_in_Gi = T_Gj_Gi.translation();
         e.covariance.diagonal() << 1.2e-5, 1.2e-5, 1.2e-5, 1e-4, 1e-4, 1e-4;
         g.entries.push_back(e);
-        if (relayed_id >= 0) {
+        if (relayed_id >= 0 && !relayed_sends_derived) {
           // And its own trajectory match of drone k: the truth, same sigma.
           const Eigen::Isometry3d T_Gj_Gk = T_Gj_W_ * ToIsometry(sim_.T_W_G(relayed_id));
           net::GlobalExtrinsicEntry ek = e;
@@ -647,6 +686,121 @@ TEST(DroneEstimator, AddsATeammateThroughAnIdentifiedTeammate) {
       EXPECT_GT(t.extrinsic_covariance(3, 3), 0.9e-4);
     }
   }
+}
+
+// The chain case of a restart (docs/swarm.md "Identification through
+// teammates"; live faults B): the observer knows teammate 1 (mutual, from
+// 10 s) and drone 2 only through 1 (graph). Teammate 1 reboots at 11.5 s
+// with a new G and its new session never identifies the observer; drone 2
+// identifies the new 1 and sends T_G2_G1 from 12.5 s. Drone 2's block is
+// derived, but the teammate it came through has left the state: the
+// observer re-identifies 1 through 2, near the truth of the new G, and
+// broadcasts it as derived. Without graph_through_derived (the old rule:
+// only first-hand intermediaries) 1 is never identified again.
+struct ChainResult {
+  int64_t restart_removed_ns = -1;  // the teammate's block left the state
+  int64_t reidentified_ns = -1;     // the teammate added again
+  std::string method;
+  int via = -1;
+  double error_m = -1.0, error_deg = -1.0;  // its T_G0_G1 at the end against the new truth
+  double sigma_p_m = -1.0;  // its smallest translation 1-sigma in the scan that added it
+  int teammate_graph_entries_sent = 0;
+};
+
+ChainResult RunRestartChain(bool graph_through_derived, bool relayed_sends_derived) {
+  sim::Scenario scenario = IndoorScenario();
+  const int observer = 0, teammate = 1, relayed = 2;
+  ObserverRun run(std::move(scenario), 14.0, observer, teammate);
+  DroneEstimatorOptions options = OptionsFor(run.drones[observer]);
+  options.swarm.graph_through_derived = graph_through_derived;
+  EXPECT_TRUE(DroneEstimator::Create(observer, options, run.drones[observer].lidar.sensor,
+                                     &run.estimator)
+                  .ok());
+  run.sink = std::make_unique<ObserverSink>(*run.simulator, observer, teammate, run.estimator.get());
+  ObserverSink& sink = *run.sink;
+  sink.mutual_at_s = 10.0;
+  sink.relayed_id = relayed;
+  sink.restart_at_s = 11.5;
+  sink.relayed_match_at_s = 12.5;
+  sink.relayed_sends_derived = relayed_sends_derived;
+  // The new G: 40 deg about the vertical and 1.5 m away from the old one.
+  sink.restart_shift.linear() = Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  sink.restart_shift.translation() = Eigen::Vector3d(1.0, -1.0, 0.5);
+  EXPECT_TRUE(run.Run());
+
+  ChainResult r;
+  for (const DroneOutput& o : sink.outputs) {
+    for (int id : o.removed_teammates) {
+      if (id == teammate && r.restart_removed_ns < 0) r.restart_removed_ns = o.ego.stamp_ns;
+    }
+    if (r.restart_removed_ns < 0) continue;
+    for (const IdentificationEvent& e : o.identifications) {
+      if (e.drone_id == teammate && r.reidentified_ns < 0) {
+        r.reidentified_ns = e.stamp_ns;
+        r.method = e.method;
+        r.via = e.via_drone_id;
+        for (const TeammateEstimate& t : o.teammates) {
+          if (t.drone_id == teammate) {
+            r.sigma_p_m = t.extrinsic_covariance.diagonal().tail<3>().cwiseSqrt().minCoeff();
+          }
+        }
+      }
+    }
+  }
+  r.teammate_graph_entries_sent = sink.teammate_graph_entries_sent;
+  const Eigen::Isometry3d T_W_Gj_new = (sink.restart_shift * ToIsometry(run.simulator->T_W_G(teammate)).inverse()).inverse();
+  const Eigen::Isometry3d T_true = ToIsometry(run.simulator->T_W_G(observer)).inverse() * T_W_Gj_new;
+  for (const TeammateEstimate& t : sink.outputs.back().teammates) {
+    if (t.drone_id != teammate) continue;
+    r.error_m = (t.T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm();
+    r.error_deg = Eigen::AngleAxisd(t.T_Gi_Gj.R_Gi_Gj().transpose() * T_true.linear()).angle() * 180.0 / M_PI;
+  }
+  return r;
+}
+
+TEST(DroneEstimator, ReidentifiesARestartedTeammateThroughAGraphDerivedTeammate) {
+  const ChainResult r = RunRestartChain(true, false);
+  ASSERT_GE(r.restart_removed_ns, 0) << "the restarted teammate was never removed";
+  ASSERT_GE(r.reidentified_ns, 0) << "the restarted teammate was never identified again";
+  EXPECT_EQ(r.method, "graph");
+  EXPECT_EQ(r.via, 2);
+  // Drone 2's first entry of the new session is taken max_message_age_s
+  // (0.5 s) after the new session was heard (11.52 s), so from 12.5 s on.
+  const double after_s = StampSeconds(r.reidentified_ns) - StampSeconds(r.restart_removed_ns);
+  std::printf("[ figures  ] re-identified %.2f s after the removal, T_G0_G1 error %.4f m %.3f deg "
+              "(1-sigma >= %.4f m)\n", after_s, r.error_m, r.error_deg, r.sigma_p_m);
+  EXPECT_LT(after_s, 1.5);
+  EXPECT_LT(r.error_m, 0.05);
+  EXPECT_LT(r.error_deg, 0.7);
+  // Composed from two edges of 1 cm each (drone 2's block, T_G2_G1): not
+  // more certain than either.
+  EXPECT_GT(r.sigma_p_m, 0.009);
+  EXPECT_GT(r.teammate_graph_entries_sent, 0);  // broadcast as derived, never first-hand
+}
+
+TEST(DroneEstimator, WithoutGraphThroughDerivedARestartedTeammateStaysUnknown) {
+  const ChainResult r = RunRestartChain(false, false);
+  ASSERT_GE(r.restart_removed_ns, 0);
+  EXPECT_LT(r.reidentified_ns, 0) << "identified by " << r.method;
+}
+
+// The offline lossy variant (docs/results.md): the observer knows drone 2
+// as the inverse of drone 2's own derived T_G2_G0 (drone 2 composed it
+// through the teammate, but does not say so) and the teammate first-hand.
+// Drone 2's chain is then taken as every teammate heard (the teammate, in
+// its first session): once the teammate restarted, drone 2 relays it.
+TEST(DroneEstimator, ReidentifiesARestartedTeammateThroughTheInverseOfADerivedEntry) {
+  const ChainResult r = RunRestartChain(true, true);
+  ASSERT_GE(r.restart_removed_ns, 0);
+  ASSERT_GE(r.reidentified_ns, 0) << "the restarted teammate was never identified again";
+  EXPECT_EQ(r.method, "graph");
+  EXPECT_EQ(r.via, 2);
+  const double after_s = StampSeconds(r.reidentified_ns) - StampSeconds(r.restart_removed_ns);
+  std::printf("[ figures  ] re-identified %.2f s after the removal, T_G0_G1 error %.4f m %.3f deg\n",
+              after_s, r.error_m, r.error_deg);
+  EXPECT_LT(after_s, 1.5);
+  EXPECT_LT(r.error_m, 0.05);
+  EXPECT_LT(r.error_deg, 0.7);
 }
 
 }  // namespace

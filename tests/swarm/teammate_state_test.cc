@@ -2,6 +2,8 @@
 // (src/swarm/teammate_state.h): T_Gi_Gk = T_Gi_Gj T_Gj_Gk and its error
 // Jacobians, checked against numeric differentiation on the manifold at
 // random, near-identity and near-pi rotations; a flipped block is caught.
+// And the rules for which teammate may relay (CanRelay) and which loops are
+// refused (ChainPassesThrough).
 #include "src/swarm/teammate_state.h"
 
 #include <gtest/gtest.h>
@@ -75,6 +77,79 @@ TEST(ComposeExtrinsic, AFlippedBlockIsCaught) {
   flipped = J_ij;
   flipped.topLeftCorner<3, 3>() *= -1.0;
   EXPECT_GT((flipped - numeric).norm(), 1e-2);
+}
+
+// i knows j first-hand and k only through j (session 1 of j). A derived k
+// may not relay while j is in the state in that session, may once j left or
+// restarted, or once enough own observations of k were fused; never when the
+// option is off.
+TEST(CanRelay, ADerivedTeammateRelaysOnceItNoLongerLeansOnItsIntermediary) {
+  const int j = 1, k = 2;
+  SwarmState x;
+  x.AddTeammate(j, GlobalExtrinsic());
+  x.AddTeammate(k, GlobalExtrinsic());
+  Teammates teammates;
+  teammates[j].session_start_ns = 100;
+  teammates[k].session_start_ns = 200;
+  SetProvenance(false, {}, &teammates[j]);
+  SetProvenance(true, {{j, 100}}, &teammates[k]);
+  SwarmOptions options;
+  options.graph_derived_min_observations = 20;
+  EXPECT_TRUE(CanRelay(teammates[j], x, teammates, options));  // first-hand
+  EXPECT_FALSE(CanRelay(teammates[k], x, teammates, options));
+  // Own observations of k make its block first-hand-like.
+  teammates[k].observations_fused = 20;
+  EXPECT_TRUE(CanRelay(teammates[k], x, teammates, options));
+  teammates[k].observations_fused = 19;
+  EXPECT_FALSE(CanRelay(teammates[k], x, teammates, options));
+  // j restarted (a new session, its block not yet removed) or left.
+  teammates[j].session_start_ns = 101;
+  EXPECT_TRUE(CanRelay(teammates[k], x, teammates, options));
+  teammates[j].session_start_ns = 100;
+  x.RemoveTeammate(j);
+  EXPECT_TRUE(CanRelay(teammates[k], x, teammates, options));
+  options.graph_through_derived = false;
+  EXPECT_FALSE(CanRelay(teammates[k], x, teammates, options));
+}
+
+// The inverse of k's own derived entry (k does not say through whom): its
+// chain is taken as every other teammate heard, in their current sessions.
+TEST(HeardTeammates, StandsInForAnUnnamedChain) {
+  const int j = 1, k = 2, m = 3, silent = 4;
+  Teammates teammates;
+  teammates[j].session_start_ns = 100;
+  teammates[j].last_heard_ns = 5;
+  teammates[k].session_start_ns = 200;
+  teammates[k].last_heard_ns = 6;
+  teammates[m].session_start_ns = 300;
+  teammates[m].last_heard_ns = 7;
+  teammates[silent].last_seen_ns = 8;  // seen, never heard
+  const std::map<int, int64_t> chain = HeardTeammates(teammates, k);
+  EXPECT_EQ(chain, (std::map<int, int64_t>{{j, 100}, {m, 300}}));
+  SetProvenance(true, chain, &teammates[k]);
+  SwarmState x;
+  x.AddTeammate(j, GlobalExtrinsic());
+  x.AddTeammate(k, GlobalExtrinsic());
+  SwarmOptions options;
+  EXPECT_FALSE(CanRelay(teammates[k], x, teammates, options));  // j is still there
+  teammates[j].session_start_ns = 101;                           // j restarted
+  EXPECT_TRUE(CanRelay(teammates[k], x, teammates, options));
+  EXPECT_FALSE(ChainPassesThrough(teammates[k], j, teammates));
+  EXPECT_TRUE(ChainPassesThrough(teammates[k], m, teammates));
+}
+
+// k's block came through j: composing j through k is a loop while j is in
+// the same session (here it left the state, e.g. timed out), not once j
+// restarted (its new frame is not in k's chain).
+TEST(ChainPassesThrough, RefusesALoopThroughTheSameSessionOnly) {
+  const int j = 1, k = 2, m = 3;
+  Teammates teammates;
+  teammates[j].session_start_ns = 100;
+  SetProvenance(true, {{j, 100}}, &teammates[k]);
+  EXPECT_TRUE(ChainPassesThrough(teammates[k], j, teammates));
+  EXPECT_FALSE(ChainPassesThrough(teammates[k], m, teammates));
+  teammates[j].session_start_ns = 101;
+  EXPECT_FALSE(ChainPassesThrough(teammates[k], j, teammates));
 }
 
 }  // namespace

@@ -118,6 +118,17 @@ struct SwarmOptions {
   /// T_Gj_Gk from a trajectory match) is added through T_Gi_Gj T_Gj_Gk
   /// without an own match (docs/swarm.md "Identification through teammates").
   bool graph_identification = true;
+  /// A teammate j that was itself added through the graph may serve as the
+  /// intermediary of the identification through teammates once its block no
+  /// longer leans on the teammates it came through: each of them left the
+  /// state or restarted (new session), or graph_derived_min_observations own
+  /// observations of j were fused into its block (docs/swarm.md
+  /// "Identification through teammates"). Off: only first-hand teammates.
+  bool graph_through_derived = true;
+  /// Own active and passive observations of a graph-derived teammate fused
+  /// into its block before it may serve as an intermediary while the
+  /// teammates it came through are still in the state [count].
+  int graph_derived_min_observations = 20;
   /// The own T_Gi_Gj estimates are broadcast this often (0 = never) [s];
   /// new ones at once. Entries per broadcast: broadcast_budget.
   double extrinsic_broadcast_period_s = 1.0;
@@ -164,6 +175,11 @@ struct SwarmOptions {
       FieldSpec::Doc("add a teammate that identified this drone, with the inverse of its T_Gj_Gi"));
     v("graph_identification", graph_identification,
       FieldSpec::Doc("add a teammate that a known teammate identified, through its T_Gj_Gk"));
+    v("graph_through_derived", graph_through_derived,
+      FieldSpec::Doc("a graph-derived teammate may relay once the teammates it came through left or "
+                     "its block was fused graph_derived_min_observations times"));
+    v("graph_derived_min_observations", graph_derived_min_observations,
+      FieldSpec::AtLeast(0, "", "own observations fused into a graph-derived block before it may relay"));
     v("extrinsic_broadcast_period_s", extrinsic_broadcast_period_s,
       FieldSpec::AtLeast(0.0, "s", "broadcast the own T_Gi_Gj estimates this often (0 = never)"));
     v("broadcast_budget", broadcast_budget,
