@@ -6,8 +6,8 @@
 //
 // Priorities, highest first (what a crowded drone keeps):
 //   1. the state (always);
-//   2. echoes for teammates whose clock offset is not settled (without them
-//      no teammate can use this drone's states; 7 B each), at most
+//   2. echoes for teammates whose clock offset is not converged yet (without
+//      them no teammate can use this drone's states; 7 B each), at most
 //      urgent_echoes_per_state;
 //   3. T_Gi_Gj entries never sent (a new identification: teammates need it
 //      for mutual and graph identification; once per teammate and session);
@@ -93,7 +93,7 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
   if (send_state) budget.Spend(budget.WireBytes(net::EgoStatePacketBytes(0)));
   const size_t state_bytes = budget.WireBytes(net::EgoStatePacketBytes(0));
 
-  // 2. Echoes for teammates whose clock offset is not settled: teammates'
+  // 2. Echoes for teammates whose clock offset is not converged: teammates'
   // states back to them (the send delay is set when the packet leaves,
   // MessageChannel::Send).
   const auto add_echoes = [&](net::ClockSync::EchoSelection selection, int most) {
@@ -103,7 +103,7 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
                              &m.echoes);
     budget.Spend((m.echoes.size() - before) * net::kStateEchoBytes);
   };
-  add_echoes(net::ClockSync::EchoSelection::kUnsettled,
+  add_echoes(net::ClockSync::EchoSelection::kUnconverged,
              options_.swarm.broadcast_budget.urgent_echoes_per_state);
 
   // 3. T_Gi_Gj entries never sent (period 0: never broadcast). One that does

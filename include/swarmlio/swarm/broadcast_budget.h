@@ -46,8 +46,9 @@ struct BroadcastBudgetOptions {
   /// Entries per GlobalExtrinsic broadcast (least recently sent first; 0 =
   /// as many as the budget affords).
   int max_extrinsic_entries_per_broadcast = 0;
-  /// Echoes per state for teammates whose clock offset is not settled that
-  /// rank above the observations; further echoes come after them.
+  /// Echoes per state for teammates whose clock offset is not converged
+  /// (ClockSyncOptions::min_samples) that rank above the observations;
+  /// further echoes come after them.
   int urgent_echoes_per_state = 1;
 
   template <class V>
@@ -61,7 +62,7 @@ struct BroadcastBudgetOptions {
     v("max_extrinsic_entries_per_broadcast", max_extrinsic_entries_per_broadcast,
       FieldSpec::InRange(0, 255, "", "T_Gi_Gj entries per broadcast (0 = as many as the budget affords)"));
     v("urgent_echoes_per_state", urgent_echoes_per_state,
-      FieldSpec::InRange(0, 8, "", "echoes for unsettled clock offsets ranked above the observations"));
+      FieldSpec::InRange(0, 8, "", "echoes for unconverged clock offsets ranked above the observations"));
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };
