@@ -126,7 +126,8 @@ Status Odometry::AddImu(const ImuSample& raw) {
       return Status::Ok();
     }
     init_error_.clear();
-    SeedMapFromStaticStart(impl_->initializer->window_start_ns());
+    impl_->seed_pending = true;  // seeded before the first scan is processed
+    impl_->seed_window_start_ns = impl_->initializer->window_start_ns();
     return Status::Ok();
   }
   impl_->imu_queue.push_back(sample);
@@ -144,7 +145,7 @@ Status Odometry::AddScan(const LidarScan& scan) {
   const int64_t end_ns = ScanEndNs(scan);
   if (!impl_->initialized || scan.stamp_ns < impl_->initialization.stamp_ns) {
     ++counters_.scans_before_init;
-    if (!impl_->initialized && options_.seed_map_from_static_start) {
+    if ((!impl_->initialized || impl_->seed_pending) && options_.seed_map_from_static_start) {
       // Kept while it may still lie in the initialization window.
       auto& kept = impl_->static_start_scans;
       kept.push_back({scan, end_ns});
@@ -177,6 +178,7 @@ Status Odometry::AddScan(const LidarScan& scan) {
 
 void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
   Impl& im = *impl_;
+  im.seed_pending = false;
   // The window passed the static test, so a scan wholly inside it was taken
   // at the initial pose: R_G_b = I, p_b_in_G = 0 (G is the IMU frame at the
   // window's end), without motion distortion.
@@ -198,6 +200,7 @@ void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
 
 Status Odometry::Flush() {
   const Status status = ProcessReadyScans(/*flush=*/true);
+  if (impl_->seed_pending) SeedMapFromStaticStart(impl_->seed_window_start_ns);
   if (impl_->window != nullptr) {
     // The scans still in the window enter the map at their current estimates.
     std::vector<internal::LeavingScan> scans;
@@ -239,6 +242,7 @@ Status Odometry::ProcessReadyScans(bool flush) {
     const PendingScan& next = impl_->scan_queue.front();
     const bool imu_covers = impl_->have_imu && impl_->last_imu_stamp_ns >= next.end_ns;
     if (!imu_covers && !flush) break;
+    if (impl_->seed_pending) SeedMapFromStaticStart(impl_->seed_window_start_ns);
     PendingScan pending = std::move(impl_->scan_queue.front());
     impl_->scan_queue.pop_front();
     const Status status = ProcessScan(pending.scan, pending.end_ns, flush);

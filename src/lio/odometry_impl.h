@@ -54,6 +54,13 @@ struct Odometry::Impl {
   std::deque<ImuSample> imu_queue;                   // after initialization, not yet propagated
   std::deque<internal::PendingScan> scan_queue;
   std::deque<internal::PendingScan> static_start_scans;  // before initialization (map seeding)
+  // Static start: initialized, the map not seeded yet. The seed waits for the
+  // first scan to process, so that a scan of the static window that arrives
+  // after the IMU sample completing the initialization (a live input
+  // releasing IMU ahead of the LiDAR, live/push_source.h) still seeds it, as
+  // it does in stamp order.
+  bool seed_pending = false;
+  int64_t seed_window_start_ns = 0;
   internal::InFlightProbe probe;
   std::vector<ScanOutput> outputs;
   int64_t last_imu_stamp_ns = 0;

@@ -76,7 +76,7 @@ struct LiveDrone::Impl {
   void NetworkLoop();
   void WaitForNetwork(int64_t stamp_ns);
   void Deliver(int64_t stamp_ns, std::deque<net::ReceivedMessage>* pending);
-  void Collect(std::vector<swarm::DroneOutput>* outputs);
+  void Collect(std::vector<swarm::DroneOutput>* outputs, bool at_flush = false);
   void QueueOutgoing(std::vector<net::SwarmMessage>* messages);
   void Send(const Outgoing& out);
   void Warn(const Status& status);
@@ -250,7 +250,7 @@ void LiveDrone::Impl::Warn(const Status& status) {
   ++stats.estimator_warnings;
 }
 
-void LiveDrone::Impl::Collect(std::vector<swarm::DroneOutput>* outputs) {
+void LiveDrone::Impl::Collect(std::vector<swarm::DroneOutput>* outputs, bool at_flush) {
   outputs->clear();
   estimator->PopOutputs(outputs);
   if (outputs->empty()) return;
@@ -263,6 +263,7 @@ void LiveDrone::Impl::Collect(std::vector<swarm::DroneOutput>* outputs) {
     ScanLatency latency;
     latency.scan_end_clock_ns = mapping.ToClockNs(o.ego.stamp_ns);
     latency.output_clock_ns = now_ns;
+    latency.at_flush = at_flush;
     sink->OnScan(o, latency);
   }
 }
@@ -314,7 +315,7 @@ void LiveDrone::Impl::EstimatorLoop() {
     QueueOutgoing(&outgoing);
   }
   Warn(estimator->Flush());
-  Collect(&outputs);
+  Collect(&outputs, /*at_flush=*/true);
   QueueOutgoing(&outgoing);
   estimator_done = true;
 }

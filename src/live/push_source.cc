@@ -1,5 +1,5 @@
-// PushSource: pushed IMU samples and scans released in stamp order
-// (push_source.h).
+// PushSource: pushed IMU samples and scans released in stamp order, or IMU
+// first (push_source.h).
 #include "swarmlio/live/push_source.h"
 
 #include <algorithm>
@@ -62,8 +62,7 @@ void PushSource::Push(Stream stream, int64_t stamp_ns, int64_t passed_ns, io::Ba
     if (closed_ || interrupted_) return;
   }
   // After the wait: a full buffer may have released later records meanwhile.
-  if (has_released_ && std::make_tuple(stamp_ns, static_cast<int>(stream)) <
-                           std::make_tuple(std::get<0>(last_released_), std::get<1>(last_released_))) {
+  if (Late(Key{stamp_ns, static_cast<int>(stream), 0})) {
     ++(stream == kImu ? stats_.imu_late : stats_.scans_late);
     return;
   }
@@ -103,11 +102,29 @@ PushSourceStats PushSource::stats() const {
   return stats_;
 }
 
+bool PushSource::Late(const Key& key) const {
+  const int stream = std::get<1>(key);
+  if (options_.ordering == PushOrdering::kImuFirst) {
+    // IMU samples run ahead of the scans: only its own stream's order counts.
+    return has_released_stream_[stream] && std::get<0>(key) < last_released_ns_[stream];
+  }
+  return has_released_ && std::make_tuple(std::get<0>(key), stream) <
+                              std::make_tuple(std::get<0>(last_released_), std::get<1>(last_released_));
+}
+
+bool PushSource::ReleasedOnArrival(const Key& key) const {
+  return options_.ordering == PushOrdering::kImuFirst && std::get<1>(key) == kImu;
+}
+
 bool PushSource::Releasable(int64_t now_ns) const {
   if (buffer_.empty()) return false;
   if (closed_ || buffer_.size() >= static_cast<size_t>(options_.max_buffered_records)) return true;
+  // The first record only: in kImuFirst a scan at the front has no IMU
+  // sample behind it (a buffered sample stamped at or after the scan would
+  // have passed it), so it holds back nothing that could go.
   const auto& [key, entry] = *buffer_.begin();
-  return OthersPassed(key) || now_ns - entry.push_clock_ns >= max_wait_ns_;
+  return ReleasedOnArrival(key) || OthersPassed(key) ||
+         now_ns - entry.push_clock_ns >= max_wait_ns_;
 }
 
 bool PushSource::OthersPassed(const Key& key) const {
@@ -149,10 +166,14 @@ Status PushSource::Next(const SensorTimeMapping& /*mapping*/, io::BagRecord* rec
   *has_record = WaitReleasable(&lock);
   if (!*has_record) return Status::Ok();
   auto node = buffer_.extract(buffer_.begin());
-  if (!OthersPassed(node.key()) && !closed_) ++stats_.released_by_timeout;
-  if (std::get<1>(node.key()) == kLidar) --buffered_scans_;
+  const Key& key = node.key();
+  if (!ReleasedOnArrival(key) && !OthersPassed(key) && !closed_) ++stats_.released_by_timeout;
+  const int stream = std::get<1>(key);
+  if (stream == kLidar) --buffered_scans_;
   has_released_ = true;
-  last_released_ = node.key();
+  last_released_ = key;
+  has_released_stream_[stream] = true;
+  last_released_ns_[stream] = std::get<0>(key);
   ++stats_.released;
   *record = std::move(node.mapped().record);
   lock.unlock();

@@ -9,7 +9,8 @@ namespace swarmlio::tools {
 
 std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& drone,
                               const LiveOutputs* outputs, const net::UdpStats& udp, double rate,
-                              const std::vector<std::string>& drone_names) {
+                              const std::vector<std::string>& drone_names,
+                              const std::vector<float>* latencies_ms) {
   const live::LiveStats& s = drone.stats();
   std::vector<double> latency;
   double imu_span_s = 0.0;
@@ -17,6 +18,7 @@ std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& dr
     latency.assign(outputs->latencies_ms().begin(), outputs->latencies_ms().end());
     imu_span_s = StampSeconds(outputs->last_imu_pose_ns() - outputs->first_imu_pose_ns());
   }
+  if (latencies_ms != nullptr) latency.assign(latencies_ms->begin(), latencies_ms->end());
   const double played_s = StampSeconds(s.sensor_end_ns - s.sensor_start_ns);
   char buffer[2048];
   std::snprintf(

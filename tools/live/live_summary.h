@@ -15,9 +15,12 @@
 namespace swarmlio::tools {
 
 /// After LiveDrone::Run(). `outputs` (may be null: no latency or IMU-rate
-/// figures) gives the latencies; `rate` the playback speed (1 live).
+/// figures) gives the latencies unless `latencies_ms` (may be null) does
+/// (the ROS node measures them at publication, with or without files);
+/// `rate` the playback speed (1 live).
 std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& drone,
                               const LiveOutputs* outputs, const net::UdpStats& udp, double rate,
-                              const std::vector<std::string>& drone_names);
+                              const std::vector<std::string>& drone_names,
+                              const std::vector<float>* latencies_ms = nullptr);
 
 }  // namespace swarmlio::tools

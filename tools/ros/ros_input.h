@@ -3,7 +3,7 @@
 // a Livox CustomMsg needs no generated message package: the bytes are
 // decoded by the project's own decoders (io::SensorMessageDecoder, the bag
 // reader's) and the records pushed into the LiveDrone's PushSource, which
-// puts the two streams in stamp order. The LiDAR type (Livox CustomMsg of
+// orders the two streams (stamp order, or IMU first: --ordering). The LiDAR type (Livox CustomMsg of
 // driver 1 or 2, or PointCloud2) is taken from the first message.
 #pragma once
 

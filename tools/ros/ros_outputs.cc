@@ -80,8 +80,8 @@ std::string RosOutputOptions::Validate() const {
 
 RosOutputs::RosOutputs(ros::NodeHandle* node, ros::NodeHandle* root,
                        const RosOutputOptions& options, const std::vector<std::string>& names,
-                       live::LiveSink* forward)
-    : node_(node), options_(options), names_(names), forward_(forward) {
+                       live::LiveSink* forward, const live::Clock* clock)
+    : node_(node), options_(options), names_(names), forward_(forward), clock_(clock) {
   const uint32_t q = static_cast<uint32_t>(options.queue_size);
   odometry_ = node->advertise<nav_msgs::Odometry>("odometry", q);
   odometry_imu_ = node->advertise<nav_msgs::Odometry>("odometry_imu", q);
@@ -123,6 +123,10 @@ void RosOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& la
   SetVector(x.q_G_b.conjugate() * x.v_b_in_G, &odometry.twist.twist.linear);
   odometry_.publish(odometry);
   ++odometry_published_;
+  if (!latency.at_flush) {  // the flush comes when the input ends (an idle timeout later)
+    latencies_ms_.push_back(static_cast<float>(
+        1e-6 * static_cast<double>(clock_->NowNs() - latency.scan_end_clock_ns)));
+  }
 
   geometry_msgs::PoseStamped pose;
   pose.header = odometry.header;

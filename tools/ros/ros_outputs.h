@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/live/clock.h"
 #include "swarmlio/live/live_drone.h"
 #include "swarmlio/live/live_sink.h"
 
@@ -48,8 +49,10 @@ class RosOutputs : public live::LiveSink {
   /// Advertises on `node` (private topics) and `root` (/tf). `names[id]`
   /// names the teammates (their frames and topics); `forward` (may be null)
   /// also receives every call (the output files).
+  /// `clock` (not owned): the LiveDrone's, times the publication latency.
   RosOutputs(ros::NodeHandle* node, ros::NodeHandle* root, const RosOutputOptions& options,
-             const std::vector<std::string>& names, live::LiveSink* forward);
+             const std::vector<std::string>& names, live::LiveSink* forward,
+             const live::Clock* clock);
 
   /// The drone whose map ~local_map shows (read on the estimator thread,
   /// inside OnScan); set before LiveDrone::Run().
@@ -60,6 +63,11 @@ class RosOutputs : public live::LiveSink {
   void OnImuPose(const live::ImuRatePose& pose) override;
 
   int64_t odometry_published() const { return odometry_published_; }
+  /// Per published ~odometry: scan end (on the LiveDrone's time line) ->
+  /// publication [ms], swarmlio_live's latency definition taken after the
+  /// publish call; not for the scans of the final flush (ScanLatency::at_flush).
+  /// Read after LiveDrone::Run().
+  const std::vector<float>& latencies_ms() const { return latencies_ms_; }
 
  private:
   std::string TeammateName(int id) const;
@@ -69,6 +77,7 @@ class RosOutputs : public live::LiveSink {
   RosOutputOptions options_;
   std::vector<std::string> names_;
   live::LiveSink* forward_;
+  const live::Clock* clock_;
   const live::LiveDrone* drone_ = nullptr;
   ros::Publisher odometry_, odometry_imu_, path_, cloud_, map_, markers_, tf_;
   std::map<int, ros::Publisher> teammate_odometry_;
@@ -76,6 +85,7 @@ class RosOutputs : public live::LiveSink {
   bool map_published_ = false;
   int64_t odometry_published_ = 0;
   nav_msgs::Path path_message_;  // the last max_path_poses poses
+  std::vector<float> latencies_ms_;  // one float per scan (bounded by the run's length)
 };
 
 }  // namespace swarmlio::tools

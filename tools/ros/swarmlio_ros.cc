@@ -3,7 +3,7 @@
 // estimator and network threads, the same UDP swarm protocol), fed by the
 // drone's sensor topics instead of a bag: IMU (sensor_msgs/Imu) and LiDAR
 // (Livox CustomMsg or sensor_msgs/PointCloud2) are subscribed raw, decoded
-// by the project's decoders and put in stamp order (live::PushSource). The
+// by the project's decoders and ordered by live::PushSource (--ordering). The
 // sensor time line is the messages' header stamps (ROS time).
 // Publishes odometry, path, clouds, teammates and TF (ros_outputs.h);
 // --output_dir also writes swarmlio_live's files.
@@ -45,10 +45,14 @@ DEFINE_int32(max_path_poses, 3000, "~path keeps the last poses");
 DEFINE_bool(tf, true, "publish world -> body on /tf");
 DEFINE_bool(registered_cloud, true, "publish ~cloud_registered (the scan in the world frame)");
 DEFINE_bool(imu_odom, true, "publish ~odometry_imu (the IMU-rate propagated state)");
+DEFINE_string(ordering, "imu_first",
+              "input order: imu_first (IMU samples on arrival, a scan once the IMU passed its "
+              "stamp: odometry right after the scan's IMU) or stamp (the bag reader's order "
+              "exactly, about one scan period later; docs/online.md)");
 DEFINE_double(max_wait_ms, 500.0,
               "a record waits at most this long for the other sensor stream to pass its stamp "
-              "(stamp order; > scan period + transport delay) [ms]");
-DEFINE_int32(max_buffered_scans, 8, "scans waiting to be put in stamp order; more are dropped");
+              "(> scan period + transport delay) [ms]");
+DEFINE_int32(max_buffered_scans, 8, "scans waiting to be ordered; more are dropped");
 DEFINE_double(idle_timeout_s, 0.0,
               "end (flush and exit) when no sensor message came for this long after the first "
               "[s]; 0 = run until Ctrl-C / rosnode kill");
@@ -71,19 +75,20 @@ int64_t WallNowNs() {
       .count();
 }
 
-std::string InputSummary(const RosInput& input, const live::PushSource& source) {
+std::string InputSummary(const RosInput& input, const live::PushSource& source,
+                         const char* ordering) {
   const RosInputStats in = input.stats();
   const live::PushSourceStats p = source.stats();
   char buffer[1024];
   std::snprintf(buffer, sizeof(buffer),
                 "  ROS input: %lld IMU and %lld LiDAR messages, %lld rejected%s%s; decoder "
                 "skipped %lld\n"
-                "  stamp order: %lld released (%lld by timeout or a full buffer), late %lld IMU / "
+                "  input order %s: %lld released (%lld by timeout or a full buffer), late %lld IMU / "
                 "%lld scans, scans dropped (buffer full) %lld, IMU pushes waited %lld\n",
                 static_cast<long long>(in.imu_messages), static_cast<long long>(in.lidar_messages),
                 static_cast<long long>(in.rejected), in.first_error.empty() ? "" : "; first: ",
                 in.first_error.c_str(),
-                static_cast<long long>(input.read_stats().TotalSkipped()),
+                static_cast<long long>(input.read_stats().TotalSkipped()), ordering,
                 static_cast<long long>(p.released), static_cast<long long>(p.released_by_timeout),
                 static_cast<long long>(p.imu_late), static_cast<long long>(p.scans_late),
                 static_cast<long long>(p.scans_dropped_full),
@@ -114,6 +119,10 @@ int Main() {
   output_options.max_path_poses = FLAGS_max_path_poses;
   output_options.publish_tf = FLAGS_tf;
   live::PushSourceOptions push_options;
+  if (!config::EnumFromString(FLAGS_ordering, &push_options.ordering)) {
+    return Fail(Status::InvalidArgument("--ordering: '" + FLAGS_ordering + "', expected one of " +
+                                        config::EnumChoices<live::PushOrdering>()));
+  }
   push_options.max_wait_ms = FLAGS_max_wait_ms;
   push_options.max_buffered_scans = FLAGS_max_buffered_scans;
   for (const std::string& invalid :
@@ -151,7 +160,7 @@ int Main() {
 
   ros::NodeHandle root;
   ros::NodeHandle node("~");
-  RosOutputs outputs(&node, &root, output_options, drone_names, files.get());
+  RosOutputs outputs(&node, &root, output_options, drone_names, files.get(), &clock);
   setup.drone = drone;
   setup.drone_id = drone_id;
   setup.transport = udp.get();
@@ -193,8 +202,8 @@ int Main() {
   spinner.stop();
 
   std::string summary = FormatLiveSummary(drone.name, *live, files.get(), udp->stats(), 1.0,
-                                          drone_names);
-  summary += InputSummary(input, *source);
+                                          drone_names, &outputs.latencies_ms());
+  summary += InputSummary(input, *source, config::EnumToString(push_options.ordering));
   std::printf("%s", summary.c_str());
   Status closed;
   if (files != nullptr) {

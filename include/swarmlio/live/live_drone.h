@@ -6,13 +6,15 @@
 // teammates through a real net::Transport (UdpTransport), with three threads:
 //
 //   input      takes each record from the source when it is due (bag:
-//              SensorTimeMapping) or released (push: stamp order); bounded
+//              SensorTimeMapping) or released (push: stamp order, or IMU
+//              first, push_source.h); bounded
 //              queue to the estimator; a scan beyond max_queued_scans
 //              waiting is dropped (IMU never);
-//   estimator  consumes records in stamp order; before a record at stamp s
+//   estimator  consumes records in the source's order; before a record at stamp s
 //              it waits until the network thread has polled up to s and
 //              delivers the received messages with arrival <= s (exactly the
-//              offline replay's rule, so a recorded run re-runs identically);
+//              offline replay's rule, so a recorded run in stamp order
+//              re-runs identically);
 //              drops a scan taken more than max_scan_backlog_s late; sends
 //              the estimator's messages through the network thread;
 //   network    every network_poll_period_ms: sends what the estimator

@@ -14,6 +14,9 @@ namespace swarmlio::live {
 struct ScanLatency {
   int64_t scan_end_clock_ns = 0;  // when the scan end was reached in playback
   int64_t output_clock_ns = 0;    // when the estimator produced the output
+  // Produced by the final flush (the input ended before an IMU sample past
+  // the scan end came): its latency is the input's end, not the pipeline's.
+  bool at_flush = false;
   /// output - scan end: waiting for the IMU sample after the scan end, queues
   /// and processing (the odometry-out latency a consumer sees).
   int64_t latency_ns() const { return output_clock_ns - scan_end_clock_ns; }

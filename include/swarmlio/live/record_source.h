@@ -3,7 +3,8 @@
 //   BagPlaybackSource  the drone's bag, each record released at its time on
 //                      the playback mapping (swarmlio_live, the live tests);
 //   PushSource         records pushed by a driver (the ROS node's subscriber
-//                      callbacks), released in stamp order (push_source.h).
+//                      callbacks), released in stamp order or IMU first
+//                      (push_source.h).
 // Records reach the estimator in the order Next() returns them; IMU samples
 // and scans only (ground-truth records are passed on and ignored).
 #pragma once
