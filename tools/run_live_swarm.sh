@@ -200,9 +200,14 @@ if [[ -n "${RESTART:-}" ]]; then
   for i in "${!drones[@]}"; do
     name="${drones[$i]}"
     [[ "$name" == "$restart_name" ]] && continue
-    # The observer's log time of the restart: restart_at x rate.
-    awk -F, -v t="$restart_name" -v at="$restart_at" -v r="$RATE" -v o="$name" '
-      NR > 1 && $2 == t && $4 > at * r { printf "  %s: %.1f s (%s)\n", o, $4 - at * r, $5; found = 1; exit }
+    # The observer's log time of the restart: restart_at x rate, less the
+    # time a late joiner's log starts after the others' (its since_first_scan_s
+    # counts from its own first scan).
+    late=0
+    [[ -n "${JOIN:-}" && "$name" == "$join_name" ]] && late="$join_s"
+    awk -F, -v t="$restart_name" -v at="$restart_at" -v r="$RATE" -v o="$name" -v late="$late" '
+      NR > 1 && $2 == t && $4 > (at - late) * r {
+        printf "  %s: %.1f s (%s)\n", o, $4 - (at - late) * r, $5; found = 1; exit }
       END { if (!found) printf "  %s: not identified again\n", o }' "$OUT/live/${name}_identifications.csv"
   done
 fi

@@ -373,8 +373,10 @@ void ClockSync::EchoesFor(int64_t now_ns, int max_echoes, EchoSelection selectio
     const int64_t age_ns = now_ns - teammate.state_arrival_ns;
     if (age_ns < 0 || age_ns > max_age_ns) continue;
     const bool settled = Settled(teammate, now_ns);
-    if (selection == EchoSelection::kAll ||
-        teammate.estimator.num_samples() < options_.min_samples) {
+    const bool selected =
+        selection == EchoSelection::kAll || (selection == EchoSelection::kUnsettled && !settled) ||
+        teammate.estimator.num_samples() < options_.min_samples;
+    if (selected) {
       const int64_t spacing_ns = settled ? period_ns : unsettled_period_ns;
       if (teammate.last_echo_ns == std::numeric_limits<int64_t>::min() ||
           now_ns - teammate.last_echo_ns >= spacing_ns) {

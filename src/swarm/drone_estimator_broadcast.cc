@@ -15,11 +15,12 @@
 //      (their only information along the degenerate direction);
 //   5. repeats of the previous scan's observations (for receivers that lost
 //      them; by default only those of degenerate teammates);
-//   6. the other observations; each observation group the least recently
+//   6. echoes for teammates whose offset is not settled (std above
+//      settled_std_s: a jittery link needs many exchanges);
+//   7. the other observations; each observation group the least recently
 //      reported teammate first;
-//   7. the other echoes (unsettled ones first; settled offsets only track the
-//      drift);
-//   8. the periodic re-broadcast of T_Gi_Gj entries already sent, the least
+//   8. the other echoes (settled offsets only track the drift);
+//   9. the periodic re-broadcast of T_Gi_Gj entries already sent, the least
 //      recently sent first: the receivers have an older version.
 // A new T_Gi_Gj entry that does not fit holds everything below it back, so the
 // credit saves up for it (otherwise the small items below would take each
@@ -28,7 +29,9 @@
 // item that does not fit waits: a later scan, with more credit or fewer
 // teammates in view, sends it.
 #include <algorithm>
+#include <cstdio>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "drone_estimator_impl.h"
@@ -65,6 +68,19 @@ bool ChooseExtrinsicEntries(const std::vector<int>& candidates, int max_entries,
 }
 
 }  // namespace
+
+std::string FormatBroadcastCounters(const DroneEstimatorCounters& c, const std::string& indent) {
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "broadcast: %lld B states, %lld B echoes, %lld B observations (%lld left out by "
+                "the byte budget), %lld B repeats, %lld B extrinsics\n",
+                static_cast<long long>(c.sent_state_bytes), static_cast<long long>(c.sent_echo_bytes),
+                static_cast<long long>(c.sent_observation_bytes),
+                static_cast<long long>(c.observations_unsent),
+                static_cast<long long>(c.sent_repeat_bytes),
+                static_cast<long long>(c.sent_extrinsic_bytes));
+  return indent + line;
+}
 
 void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& x,
                                const Eigen::MatrixXd& P) {
@@ -122,7 +138,7 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
 
   // 4. Observations: one per teammate; of teammates that report degenerate
   // scans first (they depend on them), then 5. the repeats (by default only
-  // of those), then 6. the others; each group the least recently reported
+  // of those), then 7. the others; each group the least recently reported
   // teammate first.
   std::map<int, const teammate::TeammateObservation*> seen;
   for (const teammate::TeammateObservation& o : im.detection.observations) {
@@ -169,13 +185,19 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
     m.past_observations.push_back(o);
   }
 
-  // 6. The other observations.
+  // 6. Echoes for teammates whose offset is not settled (a jittery link:
+  // the offset needs many exchanges; every unsettled_echo_period_s).
+  if (!blocked) {
+    add_echoes(net::ClockSync::EchoSelection::kUnsettled, net::EgoStateMessage::kMaxEchoes);
+  }
+
+  // 7. The other observations.
   add_observations(other_ids);
   im.detection.observations.clear();
   im.repeat.clear();
   RememberForRepeat(m, x, P);
 
-  // 7. The other echoes (settled offsets: they track the drift).
+  // 8. The other echoes (settled offsets: they track the drift).
   if (!blocked) add_echoes(net::ClockSync::EchoSelection::kAll, net::EgoStateMessage::kMaxEchoes);
   if (send_state && im.clock_sync != nullptr) im.clock_sync->NoteOwnState(t_k);
   if (send_state) {
@@ -190,7 +212,7 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
     counters_.observations_unsent += static_cast<int64_t>(seen.size() - m.observations.size());
   }
 
-  // 8. The periodic re-broadcast of the entries sent before.
+  // 9. The periodic re-broadcast of the entries sent before.
   const bool due = period > 0.0 && (!im.broadcast_extrinsics_once ||
                                     Seconds(t_k - im.last_extrinsic_broadcast_ns) >= period);
   if (due && !blocked) {

@@ -69,15 +69,7 @@ std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& dr
                 static_cast<long long>(c.messages_unsynchronized),
                 static_cast<long long>(c.messages_ignored));
   text += buffer;
-  std::snprintf(buffer, sizeof(buffer),
-                "  broadcast: %lld B states, %lld B echoes, %lld B observations (%lld left out by "
-                "the byte budget), %lld B repeats, %lld B extrinsics\n",
-                static_cast<long long>(c.sent_state_bytes), static_cast<long long>(c.sent_echo_bytes),
-                static_cast<long long>(c.sent_observation_bytes),
-                static_cast<long long>(c.observations_unsent),
-                static_cast<long long>(c.sent_repeat_bytes),
-                static_cast<long long>(c.sent_extrinsic_bytes));
-  text += buffer;
+  text += swarm::FormatBroadcastCounters(c, "  ");
   {
     char line[256];
     std::snprintf(line, sizeof(line),

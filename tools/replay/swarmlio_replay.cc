@@ -339,14 +339,7 @@ int Main() {
                   static_cast<long long>(c.active_fused), static_cast<long long>(c.passive_fused),
                   static_cast<long long>(c.gravity_fused),
                   static_cast<long long>(c.observations_rejected));
-      std::printf("  broadcast: %lld B states, %lld B echoes, %lld B observations (%lld left "
-                  "out by the byte budget), %lld B repeats, %lld B extrinsics\n",
-                  static_cast<long long>(c.sent_state_bytes),
-                  static_cast<long long>(c.sent_echo_bytes),
-                  static_cast<long long>(c.sent_observation_bytes),
-                  static_cast<long long>(c.observations_unsent),
-                  static_cast<long long>(c.sent_repeat_bytes),
-                  static_cast<long long>(c.sent_extrinsic_bytes));
+      std::printf("%s", swarm::FormatBroadcastCounters(c, "  ").c_str());
       if (const net::ClockSync* sync = run->drone(i).estimator().clock_sync()) {
         const auto& scans = run->drone(i).scans();
         const int64_t now_ns = scans.empty() ? 0 : scans.back().stamp_ns;

@@ -268,13 +268,12 @@ class ClockSync {
     EchoesFor(now_ns, options_.max_echoes_per_state, EchoSelection::kAll, echoes);
   }
   /// The same, at most max_echoes (what the sender's byte budget affords; the
-  /// others stay due) and, with kUnconverged, only teammates whose offset has
-  /// fewer than min_samples exchanges (unknown clocks: a sender ranks those
-  /// above its other content; an offset that is converged but not settled,
-  /// e.g. on a jittery link, still gets echoes every unsettled_echo_period_s
-  /// with kAll). The echoes already in *echoes count against
-  /// max_echoes_per_state.
-  enum class EchoSelection { kAll, kUnconverged };
+  /// others stay due), and only teammates whose offset is: kUnconverged,
+  /// estimated from fewer than min_samples exchanges (unknown clocks);
+  /// kUnsettled, not settled (settled_std_s); kAll, any. A sender ranks them
+  /// differently against its other content. The echoes already in *echoes
+  /// count against max_echoes_per_state.
+  enum class EchoSelection { kAll, kUnsettled, kUnconverged };
   void EchoesFor(int64_t now_ns, int max_echoes, EchoSelection selection,
                  std::vector<StateEcho>* echoes);
 

@@ -111,6 +111,11 @@ struct DroneEstimatorCounters {
   int64_t observations_unsent = 0;
 };
 
+/// One line for the tools' summaries: "broadcast: N B states, ... B
+/// extrinsics" (the sent_* counters and observations_unsent), starting with
+/// `indent`, ending with a newline.
+std::string FormatBroadcastCounters(const DroneEstimatorCounters& c, const std::string& indent);
+
 class DroneEstimator : public lio::ScanStageHooks {
  public:
   static Status Create(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar,
