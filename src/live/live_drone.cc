@@ -298,7 +298,8 @@ void LiveDrone::Impl::EstimatorLoop() {
       Collect(&outputs);
       ImuRatePose pose;
       if (options.imu_rate_odometry && imu_rate->AddImu(*imu, AccelerationFactor(), &pose)) {
-        ++stats.imu_poses;
+        if (stats.imu_poses++ == 0) stats.first_imu_pose_ns = pose.stamp_ns;
+        stats.last_imu_pose_ns = pose.stamp_ns;
         sink->OnImuPose(pose);
       }
     } else if (const LidarScan* scan = r.scan()) {

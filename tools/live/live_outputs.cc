@@ -107,9 +107,6 @@ void LiveOutputs::OnScanDropped(int64_t scan_stamp_ns, live::ScanDropReason reas
 }
 
 void LiveOutputs::OnImuPose(const live::ImuRatePose& p) {
-  if (imu_poses_ == 0) first_imu_pose_ns_ = p.stamp_ns;
-  last_imu_pose_ns_ = p.stamp_ns;
-  ++imu_poses_;
   if (imu_ == nullptr) return;
   const Eigen::Vector3d& w = p.angular_velocity_in_b_rad_s;
   Check(std::fprintf(imu_, "%.9f,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f\n",

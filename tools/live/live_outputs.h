@@ -37,9 +37,6 @@ class LiveOutputs : public live::LiveSink {
   Status Close();
 
   const std::vector<float>& latencies_ms() const { return latencies_ms_; }
-  int64_t imu_poses() const { return imu_poses_; }
-  int64_t first_imu_pose_ns() const { return first_imu_pose_ns_; }
-  int64_t last_imu_pose_ns() const { return last_imu_pose_ns_; }
 
  private:
   LiveOutputs() = default;
@@ -56,9 +53,6 @@ class LiveOutputs : public live::LiveSink {
   std::FILE* extrinsics_ = nullptr;
   std::FILE* identifications_ = nullptr;
   std::vector<float> latencies_ms_;
-  int64_t imu_poses_ = 0;
-  int64_t first_imu_pose_ns_ = 0;
-  int64_t last_imu_pose_ns_ = 0;
   std::string error_;
 };
 

@@ -13,10 +13,11 @@ std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& dr
                               const std::vector<float>* latencies_ms) {
   const live::LiveStats& s = drone.stats();
   std::vector<double> latency;
-  double imu_span_s = 0.0;
+  // From the drone's own counters: the ROS node without --output_dir has no
+  // LiveOutputs and used to print 0 Hz.
+  const double imu_span_s = StampSeconds(s.last_imu_pose_ns - s.first_imu_pose_ns);
   if (outputs != nullptr) {
     latency.assign(outputs->latencies_ms().begin(), outputs->latencies_ms().end());
-    imu_span_s = StampSeconds(outputs->last_imu_pose_ns() - outputs->first_imu_pose_ns());
   }
   if (latencies_ms != nullptr) latency.assign(latencies_ms->begin(), latencies_ms->end());
   const double played_s = StampSeconds(s.sensor_end_ns - s.sensor_start_ns);

@@ -65,6 +65,8 @@ struct LiveStats {
   int64_t scans_dropped_backlog = 0; // ScanDropReason::kBacklog
   int64_t input_stalls = 0;          // the input thread waited on a full queue
   int64_t imu_poses = 0;             // IMU-rate odometry outputs
+  int64_t first_imu_pose_ns = 0;     // their first and last stamps (sensor clock; the
+  int64_t last_imu_pose_ns = 0;      // summaries' output rate)
   int64_t messages_sent = 0;
   int64_t send_errors = 0;
   int64_t outgoing_dropped_queue = 0;// outbox full (not sent)
