@@ -1,12 +1,17 @@
 // swarm::BroadcastBudget (the token bucket on the sensor clock) and
 // swarm::SendRotation (least recently sent first), include/swarmlio/swarm/
-// broadcast_budget.h. The estimator's use of them, end to end, is in
-// drone_estimator_test.cc (BroadcastBudgetTest).
+// broadcast_budget.h; and the estimator's use of them, on one simulated drone
+// (observer_run.h).
 #include "swarmlio/swarm/broadcast_budget.h"
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <random>
+#include <utility>
+#include <vector>
+
+#include "observer_run.h"
 
 namespace swarmlio::swarm {
 namespace {
@@ -116,6 +121,64 @@ TEST(SendRotation, NeverSentFirstThenLeastRecentlySent) {
   r.Forget(9);
   EXPECT_FALSE(r.EverSent(9));
   EXPECT_EQ(r.Order({3, 5, 9}), (std::vector<int>{9, 5, 3}));
+}
+
+using test_support::IndoorScenario;
+using test_support::ObserverRun;
+
+// The most bytes sent in any window of `window_s` (messages by stamp).
+double MostBytesInWindow(std::vector<std::pair<int64_t, size_t>> sent, double window_s) {
+  std::sort(sent.begin(), sent.end());
+  double in_window = 0.0, most = 0.0;
+  size_t begin = 0;
+  for (size_t end = 0; end < sent.size(); ++end) {
+    in_window += static_cast<double>(sent[end].second);
+    while (sent[end].first - sent[begin].first >= static_cast<int64_t>(window_s * 1e9)) {
+      in_window -= static_cast<double>(sent[begin++].second);
+    }
+    most = std::max(most, in_window);
+  }
+  return most;
+}
+
+// The byte budget (swarm/broadcast_budget.h) bounds what leaves the drone
+// whatever it sees. Unlimited, the drone tracking its teammate sends more
+// than 1500 B in some second; with 1200 B/s every window of W seconds stays
+// within 1200 (W + burst_s), the state still goes out every scan, and the
+// observations are what gives (fewer, not none).
+TEST(DroneEstimator, KeepsItsBroadcastWithinTheByteBudget) {
+  const int observer = 0, teammate = 1;
+  constexpr double kBurstS = 0.2;  // a small credit: the rate binds within the 3.5 s
+  struct Sent {
+    std::vector<std::pair<int64_t, size_t>> wire_bytes;
+    int observations = 0;
+  };
+  std::map<double, Sent> sent;  // by max_bytes_per_s
+  for (double rate : {0.0, 1200.0}) {
+    ObserverRun run(IndoorScenario(), 12.5, observer, teammate, [rate](DroneEstimatorOptions* o) {
+      o->swarm.broadcast_budget.max_bytes_per_s = rate;
+      o->swarm.broadcast_budget.burst_s = kBurstS;
+      o->swarm.extrinsic_broadcast_period_s = 0.5;
+    });
+    run.sink->mutual_at_s = 9.0;  // identified then; observations from then on
+    ASSERT_TRUE(run.Run());
+    ASSERT_EQ(run.sink->ego_states_sent, static_cast<int>(run.sink->outputs.size()));
+    EXPECT_EQ(run.estimator->counters().identifications, 1) << rate;
+    sent[rate] = Sent{run.sink->wire_bytes, run.sink->observations_sent};
+  }
+  const Sent& unlimited = sent.at(0.0);
+  const Sent& limited = sent.at(1200.0);
+  EXPECT_GT(MostBytesInWindow(unlimited.wire_bytes, 1.0), 1500.0);
+  for (double window_s : {0.1, 1.0, 3.0}) {
+    EXPECT_LE(MostBytesInWindow(limited.wire_bytes, window_s), 1200.0 * (window_s + kBurstS))
+        << window_s;
+  }
+  std::printf("[ figures  ] observations sent %d unlimited, %d at 1200 B/s; most bytes in 1 s "
+              "%.0f / %.0f\n",
+              unlimited.observations, limited.observations,
+              MostBytesInWindow(unlimited.wire_bytes, 1.0), MostBytesInWindow(limited.wire_bytes, 1.0));
+  EXPECT_GT(limited.observations, 0);
+  EXPECT_LT(limited.observations, unlimited.observations);
 }
 
 }  // namespace
