@@ -3,10 +3,10 @@
 #include "swarmlio/net/clock_sync.h"
 
 #include <algorithm>
-#include <tuple>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <tuple>
 
 #include "swarmlio/net/swarm_limits.h"
 #include "swarmlio/net/wire_format.h"
@@ -353,7 +353,7 @@ void ClockSync::NoteTeammateState(const EgoStateMessage& state, int64_t arrival_
 }
 
 bool ClockSync::Settled(const Teammate& teammate, int64_t now_ns) const {
-  if (options_.settled_std_s <= 0.0) return true;
+  if (options_.settled_std_s <= 0.0) return false;  // 0 = never settled
   const ClockOffsetEstimate e = teammate.estimator.Estimate(now_ns);
   return e.converged && e.std_ns <= options_.settled_std_s * 1e9;
 }

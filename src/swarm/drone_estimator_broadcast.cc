@@ -106,8 +106,8 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
   m.cov_v_bj_in_Gj = block(ErrorStateLayout::kVelocity);
   m.degenerated = output.degenerate;
   const bool send_state = m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite();
-  if (send_state) budget.Spend(budget.WireBytes(net::EgoStatePacketBytes(0)));
   const size_t state_bytes = budget.WireBytes(net::EgoStatePacketBytes(0));
+  if (send_state) budget.Spend(state_bytes);
 
   // 2. Echoes for teammates whose clock offset is not converged: teammates'
   // states back to them (the send delay is set when the packet leaves,

@@ -430,5 +430,64 @@ TEST(ClockSync, EchoesRotateWithinTheirBudget) {
   EXPECT_TRUE(none.empty());
 }
 
+// While a teammate's offset is not settled (fewer than min_samples exchanges,
+// or std above settled_std_s) its states are echoed every
+// unsettled_echo_period_s, then every echo_period_s; the selections a byte
+// budget ranks differently see only the unconverged / unsettled ones.
+TEST(ClockSync, EchoesComeFasterUntilTheOffsetSettles) {
+  ClockSyncOptions options;
+  options.echo_period_s = 0.2;
+  options.unsettled_echo_period_s = 0.1;
+  std::unique_ptr<ClockSync> a, b;
+  ASSERT_TRUE(ClockSync::Create(0, options, &a).ok());
+  ASSERT_TRUE(ClockSync::Create(1, options, &b).ok());
+  const int64_t latency = 5 * kMs;  // fixed: the offset settles after min_samples exchanges
+  a->AddTeammate(1, 0);
+  b->AddTeammate(0, 0);
+  std::vector<int64_t> a_echo_times;
+  int unsettled_selected = 0;
+  for (int64_t t = kS; t < 6 * kS; t += 100 * kMs) {
+    // a's state (echoing b's), then b's 50 ms later (echoing a's).
+    EgoStateMessage from_a = StateAt(0, t, kMs);
+    std::vector<StateEcho> unconverged, unsettled;
+    a->EchoesFor(t, 8, ClockSync::EchoSelection::kUnconverged, &unconverged);
+    if (!unconverged.empty()) {
+      from_a.echoes = unconverged;
+    } else {
+      a->EchoesFor(t, 8, ClockSync::EchoSelection::kUnsettled, &unsettled);
+      unsettled_selected += static_cast<int>(unsettled.size());
+      from_a.echoes = unsettled;
+      if (unsettled.empty()) a->EchoesFor(t, &from_a.echoes);
+    }
+    if (!from_a.echoes.empty()) a_echo_times.push_back(t);
+    a->NoteOwnState(t);
+    b->NoteTeammateState(net_test::OnTheWire(from_a), t + kMs + latency);
+    const int64_t tb = t + 50 * kMs;
+    EgoStateMessage from_b = StateAt(1, tb, kMs);
+    b->EchoesFor(tb, &from_b.echoes);
+    b->NoteOwnState(tb);
+    a->NoteTeammateState(net_test::OnTheWire(from_b), tb + kMs + latency);
+  }
+  const ClockOffsetEstimate e = a->Estimate(1, 6 * kS);
+  ASSERT_TRUE(e.converged);
+  EXPECT_LE(e.std_ns, options.settled_std_s * 1e9);
+  // Every state while unsettled, every other state once settled.
+  ASSERT_GE(a_echo_times.size(), 6u);
+  EXPECT_EQ(a_echo_times[1] - a_echo_times[0], 100 * kMs);
+  EXPECT_EQ(a_echo_times.back() - a_echo_times[a_echo_times.size() - 2], 200 * kMs);
+  // The first min_samples exchanges come as unconverged; on this clean link
+  // the fit settles right after, so the unsettled selection sees little.
+  EXPECT_LE(unsettled_selected, 2);
+  int fast_gaps = 0;
+  for (size_t i = 1; i < a_echo_times.size(); ++i) {
+    fast_gaps += a_echo_times[i] - a_echo_times[i - 1] == 100 * kMs ? 1 : 0;
+  }
+  // a has its min_samples exchanges (one per echo of b's, b echoing every
+  // state too while unsettled) after a few of its own states: at least two
+  // 100 ms gaps (none without the unsettled period), then 200 ms ones.
+  EXPECT_GE(fast_gaps, 2);
+  EXPECT_LT(fast_gaps, 10);
+}
+
 }  // namespace
 }  // namespace swarmlio::net
