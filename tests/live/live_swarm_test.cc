@@ -30,6 +30,7 @@
 #include "swarmlio/net/simulated_network.h"
 #include "swarmlio/net/udp_transport.h"
 #include "swarmlio/replay/swarm_replay.h"
+#include "test_utils/free_port.h"
 #include "test_utils/simulated_swarm.h"
 #include "test_utils/temp_dir.h"
 
@@ -121,23 +122,6 @@ struct RacingDrone {
   }
 };
 
-int FreeUdpPort() {
-  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-  if (fd < 0) return 0;
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  int port = 0;
-  socklen_t length = sizeof(a);
-  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
-      getsockname(fd, reinterpret_cast<sockaddr*>(&a), &length) == 0) {
-    port = ntohs(a.sin_port);
-  }
-  close(fd);
-  return port;
-}
-
 double Percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -175,7 +159,7 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
   for (int i = 0; i < 3; ++i) {
     peers[i].id = i;
     peers[i].address = "127.0.0.1";
-    peers[i].port = FreeUdpPort();
+    peers[i].port = swarmlio::testing::FreeLoopbackPort();
     ASSERT_GT(peers[i].port, 0);
   }
   SteadyClock clock;

@@ -24,6 +24,7 @@
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/net/message_channel.h"
 #include "tests/net/net_test_util.h"
+#include "test_utils/free_port.h"
 
 namespace swarmlio::net {
 namespace {
@@ -53,17 +54,6 @@ sockaddr_in Address(const std::string& ip, int port) {
 
 std::string Errno(const std::string& call) {
   return call + ": " + std::generic_category().message(errno);
-}
-
-/// A UDP port on 127.0.0.1 that nothing is bound to right now (the kernel's
-/// choice), so parallel test runs do not share traffic.
-int FreePort() {
-  Socket s;
-  sockaddr_in a = Address("127.0.0.1", 0);
-  if (bind(s.fd(), reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) return 0;
-  socklen_t length = sizeof(a);
-  getsockname(s.fd(), reinterpret_cast<sockaddr*>(&a), &length);
-  return ntohs(a.sin_port);
 }
 
 /// A multicast group of 239.255/16 picked from the process id.
@@ -201,7 +191,7 @@ TEST(UdpOptions, LoadFromYaml) {
 }
 
 TEST(UdpTransport, ThreeDronesOnOneMulticastGroupSeeEveryPacket) {
-  const int port = FreePort();
+  const int port = swarmlio::testing::FreeLoopbackPort();
   ASSERT_GT(port, 0);
   const std::string reason = MulticastUnavailableReason(TestGroup(), port);
   if (!reason.empty()) {
@@ -253,7 +243,7 @@ TEST(UdpTransport, ThreeDronesOnOneMulticastGroupSeeEveryPacket) {
 }
 
 TEST(UdpTransport, MessageChannelsOverMulticast) {
-  const int port = FreePort();
+  const int port = swarmlio::testing::FreeLoopbackPort();
   const std::string reason = MulticastUnavailableReason(TestGroup(), port);
   if (!reason.empty()) {
     GTEST_SKIP() << "IPv4 multicast over loopback is not available here (" << reason << ")";
@@ -294,12 +284,12 @@ TEST(UdpTransport, MessageChannelsOverMulticast) {
 }
 
 TEST(UdpTransport, RejectsEmptyAndOversizedPacketsOnSend) {
-  const int port = FreePort();
+  const int port = swarmlio::testing::FreeLoopbackPort();
   UdpOptions o;
   o.mode = UdpMode::kUnicast;
   o.interface_address = "127.0.0.1";
   o.port = port;
-  o.peers = {UdpPeer{0, "127.0.0.1", port}, UdpPeer{1, "127.0.0.1", FreePort()}};
+  o.peers = {UdpPeer{0, "127.0.0.1", port}, UdpPeer{1, "127.0.0.1", swarmlio::testing::FreeLoopbackPort()}};
   std::unique_ptr<UdpTransport> t;
   ASSERT_TRUE(UdpTransport::Create(o, 0, &t).ok());
   const std::vector<uint8_t> big(kMaxPacketBytes + 1, 1);
@@ -316,7 +306,7 @@ TEST(UdpTransport, RejectsEmptyAndOversizedPacketsOnSend) {
 }
 
 TEST(UdpTransport, DropsEmptyAndOversizedDatagramsOnReceive) {
-  const int port = FreePort();
+  const int port = swarmlio::testing::FreeLoopbackPort();
   UdpOptions o;
   o.mode = UdpMode::kUnicast;
   o.interface_address = "127.0.0.1";
@@ -352,7 +342,7 @@ TEST(UdpTransport, DropsEmptyAndOversizedDatagramsOnReceive) {
 TEST(UdpTransport, UnicastPeersOnLoopback) {
   // The fallback where multicast is not available: one port per drone on
   // 127.0.0.1 and a static peer table.
-  const std::vector<int> ports = {FreePort(), FreePort(), FreePort()};
+  const std::vector<int> ports = {swarmlio::testing::FreeLoopbackPort(), swarmlio::testing::FreeLoopbackPort(), swarmlio::testing::FreeLoopbackPort()};
   std::vector<std::unique_ptr<UdpTransport>> drones(3);
   for (int id = 0; id < 3; ++id) {
     UdpOptions o;
@@ -383,12 +373,12 @@ TEST(UdpTransport, UnicastPeersOnLoopback) {
 }
 
 TEST(UdpTransport, PollDrainsTheSocketInBoundedSteps) {
-  const int port = FreePort();
+  const int port = swarmlio::testing::FreeLoopbackPort();
   UdpOptions o;
   o.mode = UdpMode::kUnicast;
   o.interface_address = "127.0.0.1";
   o.port = port;
-  o.peers = {UdpPeer{0, "127.0.0.1", port}, UdpPeer{1, "127.0.0.1", FreePort()}};
+  o.peers = {UdpPeer{0, "127.0.0.1", port}, UdpPeer{1, "127.0.0.1", swarmlio::testing::FreeLoopbackPort()}};
   o.max_datagrams_per_poll = 40;
   std::unique_ptr<UdpTransport> receiver, sender;
   ASSERT_TRUE(UdpTransport::Create(o, 0, &receiver).ok());
@@ -415,7 +405,7 @@ TEST(UdpTransport, PollDrainsTheSocketInBoundedSteps) {
 }
 
 TEST(UdpTransport, BroadcastOnLoopback) {
-  const int port = FreePort();
+  const int port = swarmlio::testing::FreeLoopbackPort();
   UdpOptions o;
   o.mode = UdpMode::kBroadcast;
   o.broadcast_address = "127.255.255.255";
@@ -441,12 +431,12 @@ TEST(UdpTransport, BandwidthFromTheSocketCounters) {
   // observations, one GlobalExtrinsic with 4 entries, and the clock sync at
   // 1 Hz (a request to and a response for each teammate). Each send is one
   // datagram, as in multicast mode; the counters include the IPv4 + UDP headers.
-  const int port = FreePort();
+  const int port = swarmlio::testing::FreeLoopbackPort();
   UdpOptions o;
   o.mode = UdpMode::kUnicast;
   o.interface_address = "127.0.0.1";
   o.port = port;
-  o.peers = {UdpPeer{1, "127.0.0.1", FreePort()}};
+  o.peers = {UdpPeer{1, "127.0.0.1", swarmlio::testing::FreeLoopbackPort()}};
   std::unique_ptr<UdpTransport> udp;
   ASSERT_TRUE(UdpTransport::Create(o, 0, &udp).ok());
   const PacketCodec codec = net_test::MakeCodec();
@@ -476,7 +466,7 @@ TEST(UdpTransport, SocketErrorsAreStatusesWithTheErrnoText) {
   UdpOptions o;
   o.mode = UdpMode::kUnicast;
   o.interface_address = "203.0.113.7";  // TEST-NET-3: not an address of this machine
-  o.port = FreePort();
+  o.port = swarmlio::testing::FreeLoopbackPort();
   o.peers = {UdpPeer{1, "127.0.0.1", 9}};
   std::unique_ptr<UdpTransport> t;
   const Status s = UdpTransport::Create(o, 0, &t);

@@ -44,6 +44,7 @@
 
 #include "swarmlio/replay/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
+#include "test_utils/free_port.h"
 #include "test_utils/temp_dir.h"
 
 extern char** environ;
@@ -106,22 +107,6 @@ class Child {
  private:
   pid_t pid_ = -1;
 };
-
-int FreePort(int type) {
-  const int fd = socket(AF_INET, type, 0);
-  if (fd < 0) return 0;
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  int port = 0;
-  socklen_t length = sizeof(a);
-  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
-      getsockname(fd, reinterpret_cast<sockaddr*>(&a), &length) == 0) {
-    port = ntohs(a.sin_port);
-  }
-  close(fd);
-  return port;
-}
 
 bool Listening(int port) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -215,7 +200,7 @@ TEST_P(RosNodeTest, OdometryOverRosmasterEqualsOfflineReplay) {
   ASSERT_FALSE(reference.empty());
 
   // rosmaster on a free loopback port; every process talks over 127.0.0.1.
-  const int master_port = FreePort(SOCK_STREAM);
+  const int master_port = swarmlio::testing::FreeLoopbackPort(SOCK_STREAM);
   ASSERT_GT(master_port, 0);
   const std::string master_uri = "http://127.0.0.1:" + std::to_string(master_port) + "/";
   setenv("ROS_MASTER_URI", master_uri.c_str(), 1);
@@ -254,8 +239,8 @@ TEST_P(RosNodeTest, OdometryOverRosmasterEqualsOfflineReplay) {
     Child node_process(
         {SWARMLIO_ROS_NODE, "--manifest", root + "/sim/swarm.yaml", "--drone", "uav1",
          "--key_file", key_path, "--udp_mode", "unicast", "--interface_address", "127.0.0.1",
-         "--port", std::to_string(FreePort(SOCK_DGRAM)), "--peers",
-         "uav2=127.0.0.1:" + std::to_string(FreePort(SOCK_DGRAM)), "--output_dir",
+         "--port", std::to_string(swarmlio::testing::FreeLoopbackPort(SOCK_DGRAM)), "--peers",
+         "uav2=127.0.0.1:" + std::to_string(swarmlio::testing::FreeLoopbackPort(SOCK_DGRAM)), "--output_dir",
          root + "/node", "--idle_timeout_s", "4", "--max_scan_backlog_s", "30",
          "--max_queued_scans", "1000", "--max_buffered_scans", "1000", "--max_wait_ms", "4000",
          "--ordering", GetParam()},
