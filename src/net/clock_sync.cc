@@ -8,6 +8,7 @@
 #include <limits>
 #include <tuple>
 
+#include "src/net/offset_outliers.h"
 #include "swarmlio/net/swarm_limits.h"
 #include "swarmlio/net/wire_format.h"
 
@@ -25,6 +26,9 @@ constexpr double kScalePseudoDof = 2.0;
 // Reweighting passes of the robust fit, and its Huber threshold [sigmas].
 constexpr int kReweightIterations = 4;
 constexpr double kHuberK = 2.0;
+// From this many exchanges on, those that no offset explains are found and
+// left out (src/net/offset_outliers.h); fewer cannot tell them apart.
+constexpr size_t kOutlierModelMinSamples = 20;
 // Median absolute deviation to standard deviation (normal distribution).
 constexpr double kMadToSigma = 1.4826;
 // State echo: own state stamps remembered for the echoes (10 s at 10 Hz).
@@ -125,8 +129,34 @@ void ClockOffsetEstimator::Fit() {
       std::remove_if(samples_.begin(), samples_.end(),
                      [&](const TimeSyncSample& s) { return newest - s.local_mid_ns > window_ns; }),
       samples_.end());
-  const size_t n = samples_.size();
-  if (n == 0) return;
+  if (samples_.empty()) return;
+  base_time_ns_ = newest;
+  base_offset_ns_ = samples_.back().offset_ns;
+  const double prior_b = options_.drift_prior_ppm * 1e3;  // [ns/s]
+  const double prior_info = 1.0 / (prior_b * prior_b);
+  min_delay_ns_ = std::numeric_limits<int64_t>::max();
+  for (const TimeSyncSample& s : samples_) min_delay_ns_ = std::min(min_delay_ns_, s.delay_ns);
+
+  // Exchanges that no offset explains (a fast lane, as netem's reorder: one
+  // leg skipped the path delay) are left out (src/net/offset_outliers.h).
+  std::vector<TimeSyncSample> used(samples_.begin(), samples_.end());
+  if (used.size() >= kOutlierModelMinSamples) {
+    internal::OffsetSamples window;
+    window.floor_ns = options_.timestamp_noise_s * kNsPerS;
+    window.prior_info = prior_info;
+    for (const TimeSyncSample& s : samples_) {
+      window.x.push_back(static_cast<double>(s.local_mid_ns - base_time_ns_) / kNsPerS);
+      window.y.push_back(static_cast<double>(s.offset_ns - base_offset_ns_));
+      window.round_trip.push_back(static_cast<double>(s.delay_ns));
+    }
+    const std::vector<double> outlier = internal::OffsetOutlierProbabilities(window);
+    used.clear();
+    for (size_t i = 0; i < samples_.size(); ++i) {
+      if (outlier[i] < 0.5) used.push_back(samples_[i]);
+    }
+    if (used.size() < 3) used.assign(samples_.begin(), samples_.end());
+  }
+  const size_t n = used.size();
 
   // Delay statistics. s0, the noise of an undelayed exchange, is the gap
   // between the minimum and the lower quartile of the round trips: a
@@ -136,11 +166,11 @@ void ClockOffsetEstimator::Fit() {
   // that the core wins while up to 3/4 of the exchanges are delayed.)
   std::vector<int64_t> delays;
   delays.reserve(n);
-  for (const TimeSyncSample& s : samples_) delays.push_back(s.delay_ns);
+  for (const TimeSyncSample& s : used) delays.push_back(s.delay_ns);
   std::sort(delays.begin(), delays.end());
-  min_delay_ns_ = delays.front();
+  const int64_t min_delay_ns = delays.front();  // of the exchanges used
   const double s0 = std::max(options_.timestamp_noise_s * kNsPerS,
-                             static_cast<double>(delays[n / 4] - min_delay_ns_));
+                             static_cast<double>(delays[n / 4] - min_delay_ns));
   // For a symmetric jitter an exchange's error has half the round trip's
   // std: a second, independent guess of the noise (robust: MAD).
   std::vector<double> deviations(n);
@@ -151,18 +181,14 @@ void ClockOffsetEstimator::Fit() {
                    deviations.end());
   const double delay_noise = 0.5 * kMadToSigma * deviations[n / 2];
 
-  base_time_ns_ = newest;
-  base_offset_ns_ = samples_.back().offset_ns;
   std::vector<double> xs(n), ys(n), excess(n), ws(n), abs_residuals(n);
   for (size_t i = 0; i < n; ++i) {
-    const TimeSyncSample& s = samples_[i];
+    const TimeSyncSample& s = used[i];
     xs[i] = static_cast<double>(s.local_mid_ns - base_time_ns_) / kNsPerS;  // [s], <= 0
     ys[i] = static_cast<double>(s.offset_ns - base_offset_ns_);             // [ns]
-    excess[i] = 0.5 * static_cast<double>(s.delay_ns - min_delay_ns_);      // [ns]
+    excess[i] = 0.5 * static_cast<double>(s.delay_ns - min_delay_ns);       // [ns]
     ws[i] = 1.0 / (s0 * s0 + excess[i] * excess[i]);
   }
-  const double prior_b = options_.drift_prior_ppm * 1e3;  // [ns/s]
-  const double prior_info = 1.0 / (prior_b * prior_b);
   // Weighted least squares of y = a + b x with the drift prior; `scale`
   // multiplies every sample's variance.
   double a = 0, b = 0, caa = 0, cab = 0, cbb = 0;
@@ -190,7 +216,7 @@ void ClockOffsetEstimator::Fit() {
   // least excess delay), never below s0: with a symmetric jitter the
   // minimum-delay exchange is no better than the others, and this keeps it
   // from dominating; with a queueing tail the core is the undelayed part.
-  const double median_excess = 0.5 * static_cast<double>(delays[n / 2] - min_delay_ns_);
+  const double median_excess = 0.5 * static_cast<double>(delays[n / 2] - min_delay_ns);
   double sr = s0;
   for (int iteration = 0; n >= 3 && iteration < kReweightIterations; ++iteration) {
     abs_residuals.clear();

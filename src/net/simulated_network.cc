@@ -211,11 +211,13 @@ Status SimulatedNetwork::Impl::Send(
 
 double SimulatedNetwork::Impl::SampleDelay(Link* link) {
   const LinkOptions& o = link->options;
-  double delay = o.latency_mean_s;
+  const bool skip = o.skip_delay_probability > 0.0 && link->rng.Bernoulli(o.skip_delay_probability);
+  const double mean = skip ? 0.0 : o.latency_mean_s;
+  double delay = mean;
   if (o.jitter_std_s > 0.0) {
     delay = 0.0;
     for (int attempt = 0; attempt < kMaxDelayRedraws; ++attempt) {
-      const double candidate = o.latency_mean_s + o.jitter_std_s * link->rng.StandardNormal();
+      const double candidate = mean + o.jitter_std_s * link->rng.StandardNormal();
       if (candidate >= 0.0) {
         delay = candidate;
         break;

@@ -449,6 +449,50 @@ TEST(ClockSyncSimulation, StateEchoSymmetricJitter) {
   EXPECT_LT(f.rms_ms, 3.5);
 }
 
+/// The live faults-A proxy (tools/run_live_swarm.sh): 30 % loss, 200 ms with
+/// a normal jitter of 10 ms on each leg, 10 % of the packets held back
+/// U(0, 50 ms): symmetric jitter and a one-sided tail at once.
+LinkOptions LiveFaultsLink() {
+  LinkOptions link;
+  link.latency_mean_s = 0.2;
+  link.jitter_std_s = 0.01;
+  link.loss_probability = 0.3;
+  link.reorder_probability = 0.1;
+  link.reorder_delay_max_s = 0.05;
+  return link;
+}
+
+TEST(ClockSyncSimulation, StateEchoLiveFaultsLinkReachesTheAveragingBound) {
+  // One exchange is off by N(0, 10 / sqrt(2) ms) plus the held-back tail;
+  // about 4.9 exchanges per second survive the loss both ways, so after 60 s
+  // (offset and drift fitted) no estimator does better than about
+  // 2 x 7.1 ms / sqrt(290) = 0.83 ms at the end of the window.
+  const CaseFigures f = RunCase(LiveFaultsLink(), ClockSyncOptions(), 10, 60, 60);
+  Print("state echo, live faults A link (200 ms +- 10 ms, 10 % held U(0, 50 ms)), at 60 s", f, 60);
+  EXPECT_LT(f.rms_ms, 1.6);
+  EXPECT_GE(f.within_3_sigma, 0.95);
+}
+
+/// netem's "delay 200ms 1ms reorder 25%" (and loss 30 %): a quarter of the
+/// packets skip the path delay. An exchange with one fast leg is off by
+/// 100 ms and has the shortest round trip but one (both legs fast).
+LinkOptions FastLaneLink() {
+  LinkOptions link;
+  link.latency_mean_s = 0.2;
+  link.jitter_std_s = 0.001;
+  link.loss_probability = 0.3;
+  link.skip_delay_probability = 0.25;
+  return link;
+}
+
+TEST(ClockSyncSimulation, StateEchoPacketsThatSkipTheDelayAreLeftOut) {
+  const CaseFigures f = RunCase(FastLaneLink(), ClockSyncOptions(), 10, 60, 10);
+  Print("state echo, netem reorder 25 %: 30 % loss, 200 ms +- 1 ms, 25 % skip the delay", f, 10);
+  EXPECT_LT(f.max_abs_ms, 2.0);
+  EXPECT_LT(f.rms_ms, 0.75);
+  EXPECT_GE(f.within_3_sigma, 0.97);
+}
+
 TEST(ClockSyncSimulation, StateEchoAsymmetricPathIsBiasedByHalfTheAsymmetry) {
   const NetworkOptions network = AsymmetricNetwork();
   SyncSimulation sim(network, SwarmClocks(), ClockSyncOptions());

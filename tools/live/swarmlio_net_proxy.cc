@@ -2,7 +2,9 @@
 // machine (docs/online.md "Faults"). Each route listens on one port and forwards
 // every datagram to another, after dropping it with --loss, delaying it by
 // --delay_s + N(0, --jitter_s) (truncated at 0) and, with --reorder_probability,
-// by an extra U(0, --reorder_delay_max_s), so later datagrams overtake it. In
+// by an extra U(0, --reorder_delay_max_s), so later datagrams overtake it;
+// with --skip_delay_probability a datagram skips --delay_s (netem's "reorder":
+// sent at once, overtaking the delayed ones). In
 // unicast mode the drones' peer tables name the proxy's ports instead of the
 // teammates' own:
 //
@@ -41,6 +43,8 @@ DEFINE_double(delay_s, 0.0, "mean one-way delay added [s]");
 DEFINE_double(jitter_s, 0.0, "std of the delay [s] (truncated at 0)");
 DEFINE_double(reorder_probability, 0.0, "probability of an extra delay U(0, reorder_delay_max_s)");
 DEFINE_double(reorder_delay_max_s, 0.05, "largest extra delay of a reordered datagram [s]");
+DEFINE_double(skip_delay_probability, 0.0,
+              "probability that a datagram skips --delay_s (netem's reorder)");
 DEFINE_double(duration_s, 0.0, "exit after this long (0: until SIGINT/SIGTERM) [s]");
 DEFINE_uint64(seed, 1, "random seed");
 
@@ -54,7 +58,7 @@ struct Route {
   int forward_port = 0;
   int fd = -1;
   sockaddr_in destination{};
-  uint64_t received = 0, dropped = 0, forwarded = 0, reordered = 0, send_errors = 0;
+  uint64_t received = 0, dropped = 0, forwarded = 0, reordered = 0, skipped = 0, send_errors = 0;
 };
 
 struct Pending {
@@ -113,8 +117,9 @@ int main(int argc, char** argv) {
   std::vector<Route> routes;
   if (!ParseRoutes(FLAGS_routes, &routes)) return Usage("--routes must be port=port,...");
   if (!(FLAGS_loss >= 0.0 && FLAGS_loss <= 1.0) ||
-      !(FLAGS_reorder_probability >= 0.0 && FLAGS_reorder_probability <= 1.0)) {
-    return Usage("--loss and --reorder_probability must be in [0, 1]");
+      !(FLAGS_reorder_probability >= 0.0 && FLAGS_reorder_probability <= 1.0) ||
+      !(FLAGS_skip_delay_probability >= 0.0 && FLAGS_skip_delay_probability <= 1.0)) {
+    return Usage("--loss, --reorder_probability and --skip_delay_probability must be in [0, 1]");
   }
   if (!(FLAGS_delay_s >= 0.0 && FLAGS_jitter_s >= 0.0 && FLAGS_reorder_delay_max_s >= 0.0 &&
         FLAGS_duration_s >= 0.0)) {
@@ -186,8 +191,11 @@ int main(int argc, char** argv) {
           ++r.dropped;
           continue;
         }
-        double delay = FLAGS_delay_s + FLAGS_jitter_s * normal(rng);
+        const bool skip = FLAGS_skip_delay_probability > 0.0 &&
+                          uniform(rng) < FLAGS_skip_delay_probability;
+        double delay = (skip ? 0.0 : FLAGS_delay_s) + FLAGS_jitter_s * normal(rng);
         if (delay < 0.0) delay = 0.0;
+        if (skip) ++r.skipped;
         if (FLAGS_reorder_probability > 0.0 && uniform(rng) < FLAGS_reorder_probability) {
           delay += FLAGS_reorder_delay_max_s * uniform(rng);
           ++r.reordered;
@@ -197,16 +205,18 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::printf("swarmlio_net_proxy: %.1f s, loss %.2f, delay %.3f s, jitter %.3f s, reorder %.2f\n",
+  std::printf("swarmlio_net_proxy: %.1f s, loss %.2f, delay %.3f s, jitter %.3f s, reorder %.2f, "
+              "skip delay %.2f\n",
               1e-9 * static_cast<double>(NowNs() - start_ns), FLAGS_loss, FLAGS_delay_s,
-              FLAGS_jitter_s, FLAGS_reorder_probability);
+              FLAGS_jitter_s, FLAGS_reorder_probability, FLAGS_skip_delay_probability);
   for (const Route& r : routes) {
-    std::printf("  %d -> %d: received %llu, dropped %llu, forwarded %llu (extra-delayed %llu), "
-                "undeliverable %llu\n",
+    std::printf("  %d -> %d: received %llu, dropped %llu, forwarded %llu (extra-delayed %llu, "
+                "skipped the delay %llu), undeliverable %llu\n",
                 r.listen_port, r.forward_port, static_cast<unsigned long long>(r.received),
                 static_cast<unsigned long long>(r.dropped),
                 static_cast<unsigned long long>(r.forwarded),
                 static_cast<unsigned long long>(r.reordered),
+                static_cast<unsigned long long>(r.skipped),
                 static_cast<unsigned long long>(r.send_errors));
     close(r.fd);
   }

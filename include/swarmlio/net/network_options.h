@@ -34,6 +34,8 @@ struct LinkOptions {
   double duplicate_probability = 0.0;  // a second copy is delivered
   double reorder_probability = 0.0;    // extra delay, uniform in [0, reorder_delay_max_s]
   double reorder_delay_max_s = 0.02;   // [s]
+  double skip_delay_probability = 0.0;  // sent without latency_mean_s (jitter and extra delay
+                                        // still apply): netem's "reorder", a fast lane
   double bandwidth_bytes_per_s = 0.0;  // 0: unlimited; else packets queue (FIFO)
   double max_queue_delay_s = 0.5;      // a packet that would wait longer is dropped [s]
 
@@ -51,6 +53,9 @@ struct LinkOptions {
       FieldSpec::InRange(0.0, 1.0, "", "probability of an extra delay that reorders packets"));
     v("reorder_delay_max_s", reorder_delay_max_s,
       FieldSpec::InRange(0.0, 10.0, "s", "extra delay is uniform in [0, this]"));
+    v("skip_delay_probability", skip_delay_probability,
+      FieldSpec::InRange(0.0, 1.0, "",
+                         "probability that a packet skips latency_mean_s (netem's reorder)"));
     v("bandwidth_bytes_per_s", bandwidth_bytes_per_s,
       FieldSpec::AtLeast(0.0, "B/s", "link capacity, 0 for unlimited"));
     v("max_queue_delay_s", max_queue_delay_s,
