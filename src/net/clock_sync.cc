@@ -26,9 +26,6 @@ constexpr double kScalePseudoDof = 2.0;
 // Reweighting passes of the robust fit, and its Huber threshold [sigmas].
 constexpr int kReweightIterations = 4;
 constexpr double kHuberK = 2.0;
-// From this many exchanges on, those that no offset explains are found and
-// left out (src/net/offset_outliers.h); fewer cannot tell them apart.
-constexpr size_t kOutlierModelMinSamples = 20;
 // Median absolute deviation to standard deviation (normal distribution).
 constexpr double kMadToSigma = 1.4826;
 // State echo: own state stamps remembered for the echoes (10 s at 10 Hz).
@@ -140,7 +137,7 @@ void ClockOffsetEstimator::Fit() {
   // Exchanges that no offset explains (a fast lane, as netem's reorder: one
   // leg skipped the path delay) are left out (src/net/offset_outliers.h).
   std::vector<TimeSyncSample> used(samples_.begin(), samples_.end());
-  if (used.size() >= kOutlierModelMinSamples) {
+  if (used.size() >= static_cast<size_t>(kRobustFitMinSamples)) {
     internal::OffsetSamples window;
     window.floor_ns = options_.timestamp_noise_s * kNsPerS;
     window.prior_info = prior_info;
@@ -376,6 +373,9 @@ void ClockSync::NoteTeammateState(const EgoStateMessage& state, int64_t arrival_
       ++teammate.stats.echoes_matched;
     }
   }
+  if (state.offset_report && state.offset_report->teammate_id == self_id_) {
+    NoteReport(*state.offset_report, state.stamp_ns, &teammate);
+  }
 }
 
 bool ClockSync::Settled(const Teammate& teammate, int64_t now_ns) const {
@@ -525,17 +525,6 @@ bool ClockSync::HandleMessage(const TimeSyncMessage& message,
   return false;
 }
 
-ClockOffsetEstimate ClockSync::Estimate(int teammate_id, int64_t now_ns) const {
-  auto it = teammates_.find(teammate_id);
-  if (it == teammates_.end()) return ClockOffsetEstimate();
-  return it->second.estimator.Estimate(now_ns);
-}
-
-bool ClockSync::ToLocal(int teammate_id, int64_t remote_ns, int64_t* local_ns) const {
-  auto it = teammates_.find(teammate_id);
-  return it != teammates_.end() && it->second.estimator.ToLocal(remote_ns, local_ns);
-}
-
 ClockSyncStats ClockSync::Stats(int teammate_id) const {
   auto it = teammates_.find(teammate_id);
   return it == teammates_.end() ? ClockSyncStats() : it->second.stats;
@@ -551,15 +540,18 @@ std::string FormatClockOffsets(const ClockSync& sync, int64_t now_ns,
     const ClockSyncStats st = sync.Stats(j);
     const std::string name =
         static_cast<size_t>(j) < names.size() ? names[static_cast<size_t>(j)] : "id" + std::to_string(j);
-    char line[256];
+    char line[320];
     std::snprintf(line, sizeof(line),
                   "clock of %s: offset %+.3f ms (std %.3f ms, drift %+.1f ppm), %d exchanges "
-                  "(%llu of its echoes, %llu responses), %llu requests, %llu timed out\n",
+                  "(%llu of its echoes, %llu responses), %llu requests, %llu timed out, "
+                  "its report weighs %.2f (%llu used, %llu rejected)\n",
                   name.c_str(), 1e-6 * static_cast<double>(e.offset_ns), 1e-6 * e.std_ns,
                   e.drift_ppm, e.num_samples, static_cast<unsigned long long>(st.echoes_matched),
                   static_cast<unsigned long long>(st.responses_matched),
                   static_cast<unsigned long long>(st.requests_sent),
-                  static_cast<unsigned long long>(st.requests_timed_out));
+                  static_cast<unsigned long long>(st.requests_timed_out), e.report_weight,
+                  static_cast<unsigned long long>(st.reports_used),
+                  static_cast<unsigned long long>(st.reports_rejected));
     text += indent + line;
   }
   return text;

@@ -59,7 +59,7 @@ void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
   WriteCovariance<3>(m.cov_v_bj_in_Gj, w);
   w->U16(static_cast<uint16_t>(m.send_delay_ns < 0 ? kSendDelayUnknownCode
                                                    : SyncDelayCode(m.send_delay_ns)));
-  w->U8(static_cast<uint8_t>(m.echoes.size()));
+  w->U8(static_cast<uint8_t>(m.echoes.size() | (m.offset_report ? kOffsetReportFlag : 0)));
   for (const StateEcho& e : m.echoes) {
     int64_t hold_ns = 0;
     StateEchoHoldNs(m.stamp_ns, m.send_delay_ns, e.arrival_ns, &hold_ns);  // checked by Check()
@@ -67,6 +67,11 @@ void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
     w->U16(e.stamp_ref);
     w->U16(static_cast<uint16_t>(SyncDelayCode(e.send_delay_ns)));
     w->U16(static_cast<uint16_t>(SyncDelayCode(hold_ns)));
+  }
+  if (m.offset_report) {
+    w->U8(static_cast<uint8_t>(m.offset_report->teammate_id));
+    w->U16(m.offset_report->offset_residue);
+    w->U8(static_cast<uint8_t>(m.offset_report->std_code));
   }
   for (const TeammateObservation& o : m.observations) {
     w->U8(static_cast<uint8_t>(o.observed_id));
@@ -116,18 +121,22 @@ Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* out) {
   uint16_t delay_code = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U16("send_delay", &delay_code));
   m.send_delay_ns = delay_code == kSendDelayUnknownCode ? -1 : int64_t{delay_code} * kSyncDelayStepNs;
-  uint8_t echo_count = 0;
-  SWARMLIO_RETURN_IF_ERROR(r->U8("echo count", &echo_count));
+  uint8_t echo_bits = 0;
+  SWARMLIO_RETURN_IF_ERROR(r->U8("echo bits", &echo_bits));
+  const uint8_t echo_count = echo_bits & kEchoCountMask;
+  const bool has_report = (echo_bits & kOffsetReportFlag) != 0;
   if (echo_count > EgoStateMessage::kMaxEchoes) {
     return Status::DataLoss("echo count " + std::to_string(echo_count) + " exceeds the maximum " +
                             std::to_string(EgoStateMessage::kMaxEchoes));
   }
-  if (echo_count > 0 && m.send_delay_ns < 0) {
+  if ((echo_count > 0 || has_report) && m.send_delay_ns < 0) {
     return Status::DataLoss("echo count " + std::to_string(echo_count) +
+                            (has_report ? " and an offset report" : "") +
                             " with an unknown send delay");
   }
   // The observations end the payload, or the past-observation section follows.
   const size_t lists = size_t{echo_count} * kStateEchoBytes +
+                       (has_report ? kOffsetReportBytes : 0) +
                        static_cast<size_t>(count) * kObservationBytes;
   if (lists > r->remaining()) {
     return Status::DataLoss("observation count " + std::to_string(count) + " needs " +
@@ -157,6 +166,21 @@ Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* out) {
         __builtin_sub_overflow(sent_ns, int64_t{hold} * kSyncDelayStepNs, &e.arrival_ns)) {
       return Status::DataLoss("echoes[" + std::to_string(i) + "]: arrival overflows int64");
     }
+  }
+  if (has_report) {
+    uint8_t id = 0, std_code = 0;
+    ClockOffsetReport report;
+    SWARMLIO_RETURN_IF_ERROR(r->U8("offset report teammate_id", &id));
+    SWARMLIO_RETURN_IF_ERROR(r->U16("offset report residue", &report.offset_residue));
+    SWARMLIO_RETURN_IF_ERROR(r->U8("offset report std", &std_code));
+    if (std_code < 1 || std_code > ClockOffsetReport::kMaxStdCode) {
+      return Status::DataLoss("offset report: std code " + std::to_string(std_code) +
+                              " is outside [1, " + std::to_string(ClockOffsetReport::kMaxStdCode) +
+                              "]");
+    }
+    report.teammate_id = id;
+    report.std_code = std_code;
+    m.offset_report = report;
   }
   m.observations.resize(static_cast<size_t>(count));
   for (int i = 0; i < count; ++i) {

@@ -209,6 +209,21 @@ Status Check(const EgoStateMessage& m) {
   if (!m.echoes.empty() && m.send_delay_ns < 0 && c.ok()) {
     c.Fail("echoes", -1, "need a known send_delay_ns (the hold is relative to the send time)");
   }
+  if (m.offset_report && c.ok()) {
+    c.SetContext("offset_report.");
+    if (m.send_delay_ns < 0) {
+      c.Fail("offset_report", -1, "needs a known send_delay_ns");
+    }
+    uint64_t seen_report = 0;
+    c.TeammateId("teammate_id", m.offset_report->teammate_id, m.sender_id, &seen_report);
+    if (m.offset_report->std_code < 1 ||
+        m.offset_report->std_code > ClockOffsetReport::kMaxStdCode) {
+      c.Fail("std_code", -1,
+             "= " + std::to_string(m.offset_report->std_code) + " is outside [1, " +
+                 std::to_string(ClockOffsetReport::kMaxStdCode) + "]");
+    }
+    c.SetContext("");
+  }
   uint64_t seen_echo = 0;
   for (size_t i = 0; i < m.echoes.size() && c.ok(); ++i) {
     c.SetContext("echoes[" + std::to_string(i) + "].");

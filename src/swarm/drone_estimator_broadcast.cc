@@ -185,8 +185,18 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
     m.past_observations.push_back(o);
   }
 
-  // 6. Echoes for teammates whose offset is not settled (a jittery link:
-  // the offset needs many exchanges; every unsettled_echo_period_s).
+  // 6. Our estimate of a teammate's offset, for it to fuse with its own (at
+  // most one per state, each teammate every report_period_s), then echoes
+  // for teammates whose offset is not settled (a jittery link: the offset
+  // needs many exchanges; every unsettled_echo_period_s).
+  if (!blocked && send_state && im.clock_sync != nullptr &&
+      budget.Affordable(0, net::kOffsetReportBytes, 1) > 0) {
+    net::ClockOffsetReport report;
+    if (im.clock_sync->ReportFor(t_k, &report)) {
+      m.offset_report = report;
+      budget.Spend(net::kOffsetReportBytes);
+    }
+  }
   if (!blocked) {
     add_echoes(net::ClockSync::EchoSelection::kUnsettled, net::EgoStateMessage::kMaxEchoes);
   }
@@ -205,7 +215,8 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
     const size_t past_bytes =
         m.past_observations.empty() ? 0 : 1 + net::kPastObservationBytes * m.past_observations.size();
     counters_.sent_state_bytes += static_cast<int64_t>(state_bytes);
-    counters_.sent_echo_bytes += static_cast<int64_t>(net::kStateEchoBytes * m.echoes.size());
+    counters_.sent_echo_bytes += static_cast<int64_t>(
+        net::kStateEchoBytes * m.echoes.size() + (m.offset_report ? net::kOffsetReportBytes : 0));
     counters_.sent_observation_bytes +=
         static_cast<int64_t>(net::kObservationBytes * m.observations.size());
     counters_.sent_repeat_bytes += static_cast<int64_t>(past_bytes);

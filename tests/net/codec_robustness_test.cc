@@ -252,6 +252,38 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
     Resign(&p);
     ExpectRejected(p, "observation count 2 needs");
   }
+  {  // an offset report: flagged but missing, a bad std code, the sender's own id, an
+     // unknown send delay
+    EgoStateMessage m = MakeEgoState(1, 0, 6, 0, 1);
+    m.offset_report = ClockOffsetReport{2, 1234, 20};
+    const std::vector<uint8_t> report = Encode(m);
+    const size_t count_at = kEgoFirstEcho - 1;
+    const size_t report_at = kEgoFirstEcho + kStateEchoBytes;
+    std::vector<uint8_t> p = report;
+    Resign(&p);
+    ASSERT_TRUE(Decode(p).ok());
+    ASSERT_EQ(p[count_at], kOffsetReportFlag | 1);
+    p.erase(p.begin() + static_cast<std::ptrdiff_t>(report_at),
+            p.begin() + static_cast<std::ptrdiff_t>(report_at + kOffsetReportBytes));
+    Resign(&p);
+    ExpectRejected(p, "needs");
+    p = report;
+    p[report_at + 3] = 0;
+    Resign(&p);
+    ExpectRejected(p, "offset report: std code 0 is outside [1, 254]");
+    p = report;
+    p[report_at + 3] = 255;
+    Resign(&p);
+    ExpectRejected(p, "offset report: std code 255 is outside [1, 254]");
+    p = report;
+    p[report_at] = 1;
+    Resign(&p);
+    ExpectRejected(p, "offset_report.teammate_id' = 1 is the sender itself");
+    p = report;
+    PutU16(&p, kEgoFirstEcho - 3, 65535);
+    Resign(&p);
+    ExpectRejected(p, "with an unknown send delay");
+  }
   {  // a payload shorter than the fixed part
     std::vector<uint8_t> p = ego;
     p.erase(p.begin() + kHeaderBytes + 20, p.end() - kTagBytes);

@@ -21,7 +21,7 @@ using net_test::MakeTimeSync;
 size_t ExpectedPacketBytes(const SwarmMessage& m) {
   if (const auto* e = std::get_if<EgoStateMessage>(&m)) {
     return EgoStatePacketBytes(e->observations.size(), e->past_observations.size(),
-                               e->echoes.size());
+                               e->echoes.size(), e->offset_report.has_value());
   }
   if (const auto* g = std::get_if<GlobalExtrinsicMessage>(&m)) {
     return GlobalExtrinsicPacketBytes(g->entries.size());
@@ -66,6 +66,7 @@ TEST(PacketCodec, DocumentedSizes) {
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 400u);
   EXPECT_EQ(EgoStatePacketBytes(1, 1), 117u);  // one observation, repeated in the next
   EXPECT_EQ(EgoStatePacketBytes(1, 0, 1), 108u);  // one observation, one clock echo
+  EXPECT_EQ(EgoStatePacketBytes(0, 0, 0, true), 92u);  // an offset report
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
                                 EgoStateMessage::kMaxPastObservations,
                                 EgoStateMessage::kMaxEchoes), 817u);

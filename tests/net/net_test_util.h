@@ -216,6 +216,12 @@ inline void ExpectSameMessage(const SwarmMessage& expected, const SwarmMessage& 
       EXPECT_EQ(e->echoes[i].send_delay_ns, a.echoes[i].send_delay_ns);
       EXPECT_EQ(e->echoes[i].arrival_ns, a.echoes[i].arrival_ns);
     }
+    ASSERT_EQ(e->offset_report.has_value(), a.offset_report.has_value());
+    if (e->offset_report) {
+      EXPECT_EQ(e->offset_report->teammate_id, a.offset_report->teammate_id);
+      EXPECT_EQ(e->offset_report->offset_residue, a.offset_report->offset_residue);
+      EXPECT_EQ(e->offset_report->std_code, a.offset_report->std_code);
+    }
   } else if (const auto* g = std::get_if<GlobalExtrinsicMessage>(&expected)) {
     const auto& a = std::get<GlobalExtrinsicMessage>(actual);
     EXPECT_EQ(g->sender_id, a.sender_id);
@@ -255,6 +261,12 @@ inline std::vector<SwarmMessage> AllExampleMessages() {
   messages.push_back(MakeEgoState(3, EgoStateMessage::kMaxObservations, 153,
                                   EgoStateMessage::kMaxPastObservations,
                                   EgoStateMessage::kMaxEchoes));
+  for (const auto& [echoes, std_code] : {std::pair{0, 1}, std::pair{2, ClockOffsetReport::kMaxStdCode}}) {
+    EgoStateMessage m = MakeEgoState(3, 1, 154, 0, echoes);  // with an offset report
+    if (echoes == 0) m.send_delay_ns = 120'000;
+    m.offset_report = ClockOffsetReport{63, 0xFFFE, std_code};
+    messages.push_back(m);
+  }
   for (int n : {0, 1, GlobalExtrinsicMessage::kMaxEntries}) {
     messages.push_back(MakeGlobalExtrinsic(63, n, 200 + static_cast<uint64_t>(n)));
   }

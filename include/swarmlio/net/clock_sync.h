@@ -98,6 +98,9 @@ struct ClockSyncOptions {
   double drift_prior_ppm = 100.0;    // prior std of the relative clock drift [ppm]
   int step_reset_samples = 3;        // this many consecutive samples that contradict the fit:
                                      // the teammate's clock stepped, restart from them
+  double report_period_s = 1.0;      // state echo: our estimate of a teammate's offset goes
+                                     // to it at most this often, for it to fuse with its own
+                                     // (0 = never; reports received are still used) [s]
 
   template <class V>
   void VisitFields(V&& v) {
@@ -140,6 +143,9 @@ struct ClockSyncOptions {
       FieldSpec::Positive("ppm", "prior std of the relative drift of two clocks").WithMax(1e5));
     v("step_reset_samples", step_reset_samples,
       FieldSpec::InRange(1, 64, "", "consecutive contradicting exchanges that restart the fit"));
+    v("report_period_s", report_period_s,
+      FieldSpec::InRange(0.0, 3600.0, "s",
+                         "our offset estimate sent to each teammate at most this often (0 = never)"));
   }
 
   std::string Validate() const;
@@ -172,6 +178,8 @@ struct ClockOffsetEstimate {
   int64_t min_delay_ns = 0;         // smallest round trip in the window [ns]
   int num_samples = 0;              // exchanges in the window
   int64_t last_sample_ns = 0;       // local time of the newest exchange [ns]
+  double report_weight = 0.0;       // ClockSync only: the weight of the teammate's own
+                                    // estimate (its report) in offset_ns; 0 = ours alone
 };
 
 /// Offset (and drift) of one teammate's clock from its exchanges.
@@ -182,6 +190,11 @@ class ClockOffsetEstimator {
     kOutlier,    // contradicts the fit beyond what its delay allows; held back
     kStepReset,  // step_reset_samples outliers in a row: fit restarted from them
   };
+
+  /// From this many exchanges in the window on, those that no offset
+  /// explains are found and left out (src/net/offset_outliers.h); fewer
+  /// cannot tell them apart.
+  static constexpr int kRobustFitMinSamples = 20;
 
   /// `options` must satisfy Validate().
   explicit ClockOffsetEstimator(const ClockSyncOptions& options);
@@ -230,6 +243,10 @@ struct ClockSyncStats {
   uint64_t exchanges_invalid = 0;    // stamps ReduceTimeSyncExchange rejects
   uint64_t outliers = 0;             // samples held back as contradicting the fit
   uint64_t resets = 0;               // fit restarts (clock steps)
+  uint64_t reports_sent = 0;         // our estimates of its offset sent to it
+  uint64_t reports_used = 0;         // its estimates of ours fused into ours
+  uint64_t reports_rejected = 0;     // ... received but unusable: ours not converged, or the
+                                     // two disagree beyond 5 sigma
 };
 
 /// One drone's clock synchronisation with all its teammates.
@@ -277,6 +294,13 @@ class ClockSync {
   void EchoesFor(int64_t now_ns, int max_echoes, EchoSelection selection,
                  std::vector<StateEcho>* echoes);
 
+  /// Both ends of a pair (state echo): the report for our state made at
+  /// `now_ns`, if one is due: our own estimate (not fused) of the offset of
+  /// a teammate whose estimate is converged with std <= 12.7 ms and whose
+  /// last report is report_period_s old, the least recently reported first.
+  /// Recorded as sent.
+  bool ReportFor(int64_t now_ns, ClockOffsetReport* report);
+
   /// Requests only (none with exchange = state_echo):
   /// appends the requests due at `now_ns` (at most one per teammate, t1 =
   /// now_ns) and records them as sent: send each one at `now_ns`.
@@ -295,9 +319,13 @@ class ClockSync {
                      int64_t reply_ns,
                      TimeSyncMessage* reply);
 
-  /// The teammate's offset at local time `now_ns` (valid = false if unknown).
+  /// The teammate's offset at local time `now_ns` (valid = false if unknown):
+  /// our estimate, fused with the teammate's latest report of its own
+  /// estimate of ours when there is one (docs/network.md "Both ends of a
+  /// pair"; report_weight says how much it counts).
   ClockOffsetEstimate Estimate(int teammate_id, int64_t now_ns) const;
-  /// The teammate's stamp on this drone's clock (false if not estimated yet).
+  /// The teammate's stamp on this drone's clock with that estimate (false if
+  /// not estimated yet).
   bool ToLocal(int teammate_id, int64_t remote_ns, int64_t* local_ns) const;
   /// Counters of one teammate (zeros if unknown).
   ClockSyncStats Stats(int teammate_id) const;
@@ -317,6 +345,15 @@ class ClockSync {
     int64_t state_arrival_ns = 0;
     int64_t last_echo_ns = std::numeric_limits<int64_t>::min();
     uint64_t echo_order = 0;  // echoes_made_ at its last echo (0 = never): rotation order
+    // Its report of its estimate of our offset, turned into one of its offset:
+    bool have_report = false;
+    int64_t report_local_ns = 0;   // our time of the reporting state's stamp [ns]
+    int64_t report_offset_ns = 0;  // its offset (- its estimate of ours) [ns]
+    double report_var_ns2 = 0.0;
+    uint64_t report_resets = 0;    // estimator.resets() when it came: a reset drops it
+    // Our reports of its offset.
+    int64_t last_report_ns = std::numeric_limits<int64_t>::min();
+    uint64_t report_order = 0;  // reports_made_ at our last report to it (0 = never)
     ClockOffsetEstimator estimator;
     ClockSyncStats stats;
   };
@@ -328,6 +365,10 @@ class ClockSync {
   bool echo_mode() const { return options_.exchange == ClockExchange::kStateEcho; }
   /// The offset to the teammate at now_ns is converged with std <= settled_std_s.
   bool Settled(const Teammate& teammate, int64_t now_ns) const;
+  /// A teammate's report of its estimate of our offset (state echo).
+  void NoteReport(const ClockOffsetReport& report, int64_t stamp_ns, Teammate* teammate);
+  /// Our estimate fused with the teammate's report (clock_sync_reports.cc).
+  ClockOffsetEstimate Fused(const Teammate& teammate, int64_t now_ns) const;
 
   int self_id_;
   ClockSyncOptions options_;
@@ -338,6 +379,7 @@ class ClockSync {
   std::map<int, Teammate> teammates_;  // ordered: deterministic request order
   std::deque<int64_t> own_stamps_;     // our last kOwnStates state stamps (state echo)
   uint64_t echoes_made_ = 0;
+  uint64_t reports_made_ = 0;
   uint64_t requests_answered_ = 0;
 };
 

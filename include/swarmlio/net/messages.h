@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <variant>
 #include <vector>
 
@@ -58,6 +59,18 @@ struct StateEcho {
   int64_t arrival_ns = 0;    // when it arrived at j (j's clock) [ns]
 };
 
+/// Drone j's own estimate of teammate k's clock offset (k's clock - j's
+/// clock) at j's state stamp, for k to fuse with its own estimate of j's
+/// (wire version 6; docs/network.md "Both ends of a pair"). It travels as a
+/// residue modulo 65.536 ms: k resolves it against its own estimate, which
+/// agrees with it to a few milliseconds once both have converged.
+struct ClockOffsetReport {
+  static constexpr int kMaxStdCode = 254;
+  int teammate_id = 0;          // k
+  uint16_t offset_residue = 0;  // round(offset / kOffsetReportStepNs) mod 2^16
+  int std_code = 1;             // the estimate's std in kOffsetReportStdStepNs, 1..kMaxStdCode
+};
+
 /// The reference a StateEcho carries for a state stamped `stamp_ns`: its
 /// stamp in whole milliseconds modulo 2^16 (unique over 65 s of states).
 inline uint16_t StateEchoRef(int64_t stamp_ns) {
@@ -99,6 +112,8 @@ struct EgoStateMessage {
   /// Teammates' states j received, echoed for their clock synchronisation
   /// (distinct ids, none == sender_id; only with send_delay_ns >= 0).
   std::vector<StateEcho> echoes;
+  /// At most one of j's offset estimates (only with send_delay_ns >= 0).
+  std::optional<ClockOffsetReport> offset_report;
 };
 
 /// How the sender obtained a global extrinsic.

@@ -26,8 +26,9 @@ namespace swarmlio::net {
 inline constexpr uint8_t kMagic = 0x53;  // 'S'
 /// 2: gravity in GlobalExtrinsic; 3: quantized payloads, 6-byte header, 16-byte tag;
 /// 4: past observations at the end of EgoState; 5: send delay and state echoes in
-/// EgoState (clock synchronisation without TimeSync packets).
-inline constexpr uint8_t kProtocolVersion = 5;
+/// EgoState (clock synchronisation without TimeSync packets); 6: an optional clock
+/// offset report after the echoes.
+inline constexpr uint8_t kProtocolVersion = 6;
 inline constexpr size_t kHeaderBytes = 6;
 inline constexpr size_t kTagBytes = 16;  // HMAC-SHA512-256 truncated to 128 bits
 inline constexpr size_t kPacketOverheadBytes = kHeaderBytes + kTagBytes;
@@ -72,9 +73,12 @@ constexpr size_t CovarianceBytes(size_t n) { return n + n * (n - 1) / 2; }
 //   bits u8 (0-1 q largest index, 2 degenerated, 3-7 observation count) |
 //   q_Gj_bj 3 x i16 | p_bj_in_Gj f32 x3 | v_bj_in_Gj f16 x3 | omega_bj_in_bj f16 x3 |
 //   cov_theta cov(3) | cov_p cov(3) | cov_v cov(3) |
-//   send delay u16 (10 us; 65535 = not known) | echo count u8 (0..kMaxEchoes) |
+//   send delay u16 (10 us; 65535 = not known) |
+//   echo bits u8 (0-6 echo count 0..kMaxEchoes, 7 offset report follows (version 6)) |
 //   echo count x { teammate id u8 | stamp ref u16 | its send delay u16 (10 us) |
 //                  hold u16 (10 us: this packet's send time - the echoed state's arrival) } |
+//   optional offset report { teammate id u8 | offset residue u16 (1 us, mod 2^16) |
+//                            std u8 (50 us, 1..254) } |
 //   count x { observed id u8 | p_bk_in_bj 3 x i16 (2 mm) | cov(3) } |
 //   optional (version 4), present only when the message has past observations:
 //   past count u8 (1..kMaxPastObservations) |
@@ -83,6 +87,11 @@ constexpr size_t CovarianceBytes(size_t n) { return n + n * (n - 1) / 2; }
 inline constexpr size_t kEgoStateFixedBytes =
     8 + 6 + 1 + 6 + 12 + 6 + 6 + 3 * CovarianceBytes(3) + 2 + 1;
 inline constexpr size_t kStateEchoBytes = 1 + 2 + 2 + 2;
+inline constexpr uint8_t kEchoCountMask = 0x7F;
+inline constexpr uint8_t kOffsetReportFlag = 0x80;
+inline constexpr size_t kOffsetReportBytes = 1 + 2 + 1;
+inline constexpr int64_t kOffsetReportStepNs = 1000;       // 1 us: the residue wraps at 65.536 ms
+inline constexpr int64_t kOffsetReportStdStepNs = 50000;   // 50 us: std up to 12.7 ms
 // Send delay, an echo's send delay and hold: uint16 code = round(ns / kSyncDelayStepNs).
 inline constexpr int64_t kSyncDelayStepNs = 10000;  // 10 us
 inline constexpr int kSendDelayMaxCode = 65534;     // 655.34 ms; 65535 = not known
@@ -120,8 +129,9 @@ inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 6 + 12 + CovarianceBytes(
 inline constexpr size_t kTimeSyncBytes = 1 + 1 + 3 * 8;
 
 constexpr size_t EgoStatePacketBytes(size_t num_observations, size_t num_past_observations = 0,
-                                     size_t num_echoes = 0) {
+                                     size_t num_echoes = 0, bool offset_report = false) {
   return kPacketOverheadBytes + kEgoStateFixedBytes + kStateEchoBytes * num_echoes +
+         (offset_report ? kOffsetReportBytes : 0) +
          kObservationBytes * num_observations +
          (num_past_observations > 0 ? 1 + kPastObservationBytes * num_past_observations : 0);
 }
@@ -137,8 +147,8 @@ static_assert(kGlobalExtrinsicFixedBytes == 27 && kExtrinsicEntryBytes == 41,
               "layout changed: update docs");
 static_assert(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
                                   EgoStateMessage::kMaxPastObservations,
-                                  EgoStateMessage::kMaxEchoes) <= kMaxPacketBytes);
-static_assert(EgoStateMessage::kMaxEchoes <= 255, "the echo count travels in one byte");
+                                  EgoStateMessage::kMaxEchoes, true) <= kMaxPacketBytes);
+static_assert(EgoStateMessage::kMaxEchoes <= kEchoCountMask, "the echo count travels in 7 bits");
 static_assert(EgoStateMessage::kMaxPastObservations <= 255, "the past count travels in one byte");
 static_assert(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries) <= kMaxPacketBytes);
 static_assert(TimeSyncPacketBytes() <= kMaxPacketBytes);

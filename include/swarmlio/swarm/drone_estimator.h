@@ -104,7 +104,7 @@ struct DroneEstimatorCounters {
   // state's and the extrinsic broadcasts' shares), and the observations the
   // byte budget left out (docs/swarm.md "Broadcast budget").
   int64_t sent_state_bytes = 0;
-  int64_t sent_echo_bytes = 0;
+  int64_t sent_echo_bytes = 0;  // state echoes and offset reports
   int64_t sent_observation_bytes = 0;
   int64_t sent_repeat_bytes = 0;
   int64_t sent_extrinsic_bytes = 0;
