@@ -262,6 +262,10 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
   const Clock::time_point t_start = Clock::now();
   ScanOutput out;
   out.scan_stamp_ns = scan.stamp_ns;
+  // In flight, the odometry proper starts at started_ns (the newest input when
+  // the last pass ended); at rest started_ns is the initialization's stamp.
+  out.held_by_initialization = im.initialization.started_ns > im.initialization.stamp_ns &&
+                               end_ns <= im.initialization.started_ns;
   out.num_raw_points = static_cast<int>(scan.points.size());
 
   // 1. Preprocess.

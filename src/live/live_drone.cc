@@ -257,6 +257,7 @@ void LiveDrone::Impl::Collect(std::vector<swarm::DroneOutput>* outputs, bool at_
   const int64_t now_ns = setup.clock->NowNs();
   for (const swarm::DroneOutput& o : *outputs) {
     ++stats.scans_processed;
+    if (o.ego.held_by_initialization) ++stats.scans_held_by_initialization;
     if (!o.ego.update_error.empty()) Warn(Status::Internal("update failed: " + o.ego.update_error));
     if (!o.ego.hook_error.empty()) Warn(Status::Internal("swarm front end: " + o.ego.hook_error));
     imu_rate->ResetToScan(o.ego.state, o.ego.stamp_ns, AccelerationFactor());

@@ -46,6 +46,7 @@ ScanRecord ToScanRecord(const lio::ScanOutput& o) {
   r.velocity_covariance = o.covariance.block<3, 3>(ErrorStateLayout::kVelocity.offset,
                                                    ErrorStateLayout::kVelocity.offset);
   r.updated = o.updated;
+  r.held_by_initialization = o.held_by_initialization;
   r.num_raw_points = o.num_raw_points;
   r.num_points = o.num_points;
   r.num_correspondences = o.num_correspondences;

@@ -21,12 +21,17 @@ std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& dr
   }
   if (latencies_ms != nullptr) latency.assign(latencies_ms->begin(), latencies_ms->end());
   const double played_s = StampSeconds(s.sensor_end_ns - s.sensor_start_ns);
+  const std::string held =
+      s.scans_held_by_initialization > 0
+          ? " (not counted: " + std::to_string(s.scans_held_by_initialization) +
+                " scans held by the in-flight initialization)"
+          : "";
   char buffer[2048];
   std::snprintf(
       buffer, sizeof(buffer),
       "%s: played %.1f s of log in %.1f s (rate %.2f)\n"
       "  scans: %lld played, %lld processed, %lld dropped (%lld queue full, %lld backlog)\n"
-      "  latency scan end -> odometry out [ms]: median %.2f  p95 %.2f  max %.2f\n"
+      "  latency scan end -> odometry out [ms]: median %.2f  p95 %.2f  max %.2f%s\n"
       "  IMU-rate odometry: %lld poses (%.0f Hz)\n"
       "  messages: sent %lld (send errors %lld, outbox full %lld); received %llu, rejected %llu "
       "(last: %s), duplicates %llu, own %llu; delivered %lld, message queue full %lld\n"
@@ -39,7 +44,7 @@ std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& dr
       static_cast<long long>(s.scans_dropped_queue + s.scans_dropped_backlog),
       static_cast<long long>(s.scans_dropped_queue), static_cast<long long>(s.scans_dropped_backlog),
       eval::Percentile(latency, 0.5), eval::Percentile(latency, 0.95),
-      eval::Percentile(latency, 1.0), static_cast<long long>(s.imu_poses),
+      eval::Percentile(latency, 1.0), held.c_str(), static_cast<long long>(s.imu_poses),
       imu_span_s > 0 ? static_cast<double>(s.imu_poses - 1) / imu_span_s : 0.0,
       static_cast<long long>(s.messages_sent), static_cast<long long>(s.send_errors),
       static_cast<long long>(s.outgoing_dropped_queue),

@@ -123,7 +123,9 @@ void RosOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& la
   SetVector(x.q_G_b.conjugate() * x.v_b_in_G, &odometry.twist.twist.linear);
   odometry_.publish(odometry);
   ++odometry_published_;
-  if (!latency.at_flush) {  // the flush comes when the input ends (an idle timeout later)
+  // The flush comes when the input ends (an idle timeout later); a scan the
+  // in-flight initialization held has its delay, not the pipeline's.
+  if (!latency.at_flush && !o.ego.held_by_initialization) {
     latencies_ms_.push_back(static_cast<float>(
         1e-6 * static_cast<double>(clock_->NowNs() - latency.scan_end_clock_ns)));
   }

@@ -66,6 +66,10 @@ struct ScanOutput {
   EgoState state;             // posterior (or prediction when not updated)
   Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim> covariance;
   bool updated = false;           // false: map initialisation, too few points, failed update
+  // The scan arrived while the in-flight initialization's passes ran and was
+  // processed when they ended (docs/imu.md section 1b): its output came that
+  // much later, which is the initialization's delay, not the pipeline's.
+  bool held_by_initialization = false;
   std::string update_error;       // why an attempted update failed ("" otherwise)
   int num_raw_points = 0;         // points in the message
   int num_points = 0;             // after preprocessing

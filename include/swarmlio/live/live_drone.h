@@ -61,6 +61,8 @@ struct LiveStats {
   int64_t imu_samples = 0;
   int64_t scans_played = 0;
   int64_t scans_processed = 0;       // estimator outputs
+  int64_t scans_held_by_initialization = 0;  // of those: held by the in-flight
+                                             // initialization (lio::ScanOutput)
   int64_t scans_dropped_queue = 0;   // ScanDropReason::kQueueFull
   int64_t scans_dropped_backlog = 0; // ScanDropReason::kBacklog
   int64_t input_stalls = 0;          // the input thread waited on a full queue

@@ -42,6 +42,7 @@ struct ScanRecord {
   Eigen::Matrix<double, 6, 6> pose_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();
   bool updated = false;
+  bool held_by_initialization = false;  // see lio::ScanOutput
   int num_raw_points = 0;
   int num_points = 0;
   int num_correspondences = 0;
