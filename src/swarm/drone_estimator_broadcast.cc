@@ -30,6 +30,7 @@
 // teammates in view, sends it.
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -55,6 +56,9 @@ size_t ExtrinsicWireBytes(const BroadcastBudget& budget, size_t n) {
 
 // Appends `candidates` (in order) to `chosen` while the entry cap allows and
 // the budget affords the growing broadcast; false if the budget refused one.
+// Overdue T_Gi_Gj entries may take at most this share of the byte budget.
+constexpr double kOverdueBudgetShare = 0.1;
+
 bool ChooseExtrinsicEntries(const std::vector<int>& candidates, int max_entries,
                             BroadcastBudget* budget, std::vector<int>* chosen) {
   for (int id : candidates) {
@@ -122,16 +126,32 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
   add_echoes(net::ClockSync::EchoSelection::kUnconverged,
              options_.swarm.broadcast_budget.urgent_echoes_per_state);
 
-  // 3. T_Gi_Gj entries never sent (period 0: never broadcast). One that does
-  // not fit holds everything below back: the credit saves up for it.
+  // 3. T_Gi_Gj entries never sent, or not for extrinsic_overdue_s (period 0:
+  // never broadcast), the never sent first. One that does not fit holds
+  // everything below back: the credit saves up for it.
   const double period = options_.swarm.extrinsic_broadcast_period_s;
   const int max_entries = options_.swarm.broadcast_budget.max_extrinsic_entries_per_broadcast;
+  // Overdue after extrinsic_overdue_s, or longer when the entries would then
+  // take more than kOverdueBudgetShare of the budget (a large swarm).
+  const BroadcastBudgetOptions& bo = options_.swarm.broadcast_budget;
+  double overdue_s = bo.extrinsic_overdue_s;
+  if (overdue_s > 0.0 && bo.max_bytes_per_s > 0.0) {
+    overdue_s = std::max(overdue_s, static_cast<double>(x.layout().teammate_ids().size() *
+                                                        net::kExtrinsicEntryBytes) /
+                                        (kOverdueBudgetShare * bo.max_bytes_per_s));
+  }
   std::vector<int> fresh;
   std::vector<int> sent_before;
   if (period > 0.0) {
     for (int id : x.layout().teammate_ids()) {
-      (im.extrinsic_rotation.EverSent(id) ? sent_before : fresh).push_back(id);
+      const bool urgent =
+          !im.extrinsic_rotation.EverSent(id) ||
+          (overdue_s > 0.0 &&
+           im.extrinsic_rotation.LastSentNs(id) != std::numeric_limits<int64_t>::min() &&
+           Seconds(t_k - im.extrinsic_rotation.LastSentNs(id)) >= overdue_s);
+      (urgent ? fresh : sent_before).push_back(id);
     }
+    fresh = im.extrinsic_rotation.Order(std::move(fresh));
   }
   std::vector<int> entry_ids;
   bool blocked = !ChooseExtrinsicEntries(fresh, max_entries, &budget, &entry_ids);
@@ -247,7 +267,7 @@ void DroneEstimator::Broadcast(const lio::ScanOutput& output, const SwarmState& 
     const Segment b = x.layout().TeammateBlock(id);
     e.covariance = P.block<6, 6>(b.offset, b.offset);
     e.covariance = 0.5 * (e.covariance + e.covariance.transpose()).eval();
-    im.extrinsic_rotation.MarkSent(id);  // a non-finite one is not retried before its turn
+    im.extrinsic_rotation.MarkSent(id, t_k);  // a non-finite one is not retried before its turn
     if (e.q_Gi_Gj.coeffs().allFinite() && e.p_Gj_in_Gi.allFinite() && e.covariance.allFinite()) {
       entries.push_back(e);
     }

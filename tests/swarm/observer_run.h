@@ -97,13 +97,15 @@ class ObserverSink : public sim::DroneSink {
         wire_bytes.emplace_back(e->stamp_ns, kIpUdpBytes + net::EgoStatePacketBytes(
                                                                e->observations.size(),
                                                                e->past_observations.size(),
-                                                               e->echoes.size()));
+                                                               e->echoes.size(),
+                                                               e->offset_report.has_value()));
       }
       if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&m)) {
         ++extrinsic_messages_sent;
         wire_bytes.emplace_back(g->stamp_ns,
                                 kIpUdpBytes + net::GlobalExtrinsicPacketBytes(g->entries.size()));
         for (const net::GlobalExtrinsicEntry& e : g->entries) {
+          if (e.teammate_id == teammate_) teammate_entry_stamps.push_back(g->stamp_ns);
           if (e.teammate_id == relayed_id) {
             ++graph_entries_sent;
             EXPECT_EQ(e.source, net::ExtrinsicSource::kGraph);  // never relayed as first-hand
@@ -123,6 +125,7 @@ class ObserverSink : public sim::DroneSink {
   int observations_sent = 0;        // in the states
   std::vector<std::pair<int64_t, size_t>> wire_bytes;  // (stamp, bytes on the wire) per message
   int extrinsic_messages_sent = 0;  // the own T_Gi_Gj, about once a second once identified
+  std::vector<int64_t> teammate_entry_stamps;  // broadcasts with the teammate's entry
   double restart_at_s = 1e9;  // the teammate reboots then (new session_start)
   double mutual_at_s = 1e9;   // from then on the teammate sends its T_Gj_Gi (it identified us)
   int indefinite_every_k = 0;  // every k-th broadcast has indefinite covariances (0: none)

@@ -26,6 +26,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -50,6 +51,13 @@ struct BroadcastBudgetOptions {
   /// (ClockSyncOptions::min_samples) that rank above the observations;
   /// further echoes come after them.
   int urgent_echoes_per_state = 1;
+  // A T_Gi_Gj entry not sent for this long goes out like a new one, ahead of
+  // the observations and echoes (0 = never): on a saturated budget the
+  // periodic re-broadcast would otherwise starve, and a teammate that lost
+  // the one new-entry broadcast would never hear it again. Longer when the
+  // entries would then take more than 10 % of max_bytes_per_s (39 entries at
+  // 1450 B/s: 11 s) [s].
+  double extrinsic_overdue_s = 3.0;
 
   template <class V>
   void VisitFields(V&& v) {
@@ -63,6 +71,9 @@ struct BroadcastBudgetOptions {
       FieldSpec::InRange(0, 255, "", "T_Gi_Gj entries per broadcast (0 = as many as the budget affords)"));
     v("urgent_echoes_per_state", urgent_echoes_per_state,
       FieldSpec::InRange(0, 8, "", "echoes for unconverged clock offsets ranked above the observations"));
+    v("extrinsic_overdue_s", extrinsic_overdue_s,
+      FieldSpec::InRange(0.0, 3600.0, "s",
+                         "an entry not sent for this long goes out like a new one (0 = never)"));
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };
@@ -101,12 +112,25 @@ class SendRotation {
  public:
   /// `ids` sorted in sending order.
   std::vector<int> Order(std::vector<int> ids) const;
-  void MarkSent(int id) { last_sent_[id] = ++sends_; }
+  /// `stamp_ns`: when (sensor clock), for LastSentNs.
+  void MarkSent(int id, int64_t stamp_ns = std::numeric_limits<int64_t>::min()) {
+    last_sent_[id] = ++sends_;
+    last_sent_ns_[id] = stamp_ns;
+  }
   bool EverSent(int id) const { return last_sent_.count(id) > 0; }
-  void Forget(int id) { last_sent_.erase(id); }
+  /// The stamp given at id's last send (INT64_MIN if never sent or none given).
+  int64_t LastSentNs(int id) const {
+    const auto it = last_sent_ns_.find(id);
+    return it == last_sent_ns_.end() ? std::numeric_limits<int64_t>::min() : it->second;
+  }
+  void Forget(int id) {
+    last_sent_.erase(id);
+    last_sent_ns_.erase(id);
+  }
 
  private:
   std::map<int, uint64_t> last_sent_;  // id -> send count at its last send
+  std::map<int, int64_t> last_sent_ns_;  // id -> stamp of its last send
   uint64_t sends_ = 0;
 };
 
