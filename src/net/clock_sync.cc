@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "src/net/offset_outliers.h"
+#include "src/net/weighted_line.h"
 #include "swarmlio/net/swarm_limits.h"
 #include "swarmlio/net/wire_format.h"
 
@@ -188,24 +189,10 @@ void ClockOffsetEstimator::Fit() {
   }
   // Weighted least squares of y = a + b x with the drift prior; `scale`
   // multiplies every sample's variance.
-  double a = 0, b = 0, caa = 0, cab = 0, cbb = 0;
-  auto solve = [&](double scale) {
-    double sw = 0, swx = 0, swxx = 0, swy = 0, swxy = 0;
-    for (size_t i = 0; i < n; ++i) {
-      sw += ws[i];
-      swx += ws[i] * xs[i];
-      swxx += ws[i] * xs[i] * xs[i];
-      swy += ws[i] * ys[i];
-      swxy += ws[i] * xs[i] * ys[i];
-    }
-    const double n00 = sw / scale, n01 = swx / scale, n11 = swxx / scale + prior_info;
-    const double det = n00 * n11 - n01 * n01;
-    caa = n11 / det;
-    cab = -n01 / det;
-    cbb = n00 / det;
-    a = caa * (swy / scale) + cab * (swxy / scale);
-    b = cab * (swy / scale) + cbb * (swxy / scale);
-  };
+  // (The prior keeps the normal matrix regular: the fit always succeeds.)
+  internal::WeightedLine line;
+  double &a = line.a, &b = line.b;
+  auto solve = [&](double scale) { internal::FitWeightedLine(xs, ys, ws, scale, prior_info, &line); };
   solve(1.0);
   // Iteratively reweighted: a sample's noise is the residual scale sr plus
   // its excess delay, and a Huber weight tempers samples beyond kHuberK of
@@ -247,9 +234,9 @@ void ClockOffsetEstimator::Fit() {
   solve((chi2 + kScalePseudoDof * prior_ratio) / (dof + kScalePseudoDof));
   a_ns_ = a;
   b_ns_per_s_ = b;
-  cov_aa_ = caa;
-  cov_ab_ = cab;
-  cov_bb_ = cbb;
+  cov_aa_ = line.caa;
+  cov_ab_ = line.cab;
+  cov_bb_ = line.cbb;
 }
 
 double ClockOffsetEstimator::OffsetAt(int64_t local_ns) const {

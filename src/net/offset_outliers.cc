@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "src/net/weighted_line.h"
+
 namespace swarmlio::net::internal {
 namespace {
 
@@ -24,21 +26,12 @@ double Median(std::vector<double> v) {
   return v[mid];
 }
 
-/// Weighted least squares of y = a + b x with the prior b ~ N(0, 1 / prior_info).
+/// The inliers' line (weights: responsibilities), from and into (a, b).
 void SolveLine(const OffsetSamples& in, const std::vector<double>& w, double* a, double* b) {
-  double sw = 0, swx = 0, swxx = 0, swy = 0, swxy = 0;
-  for (size_t i = 0; i < w.size(); ++i) {
-    sw += w[i];
-    swx += w[i] * in.x[i];
-    swxx += w[i] * in.x[i] * in.x[i];
-    swy += w[i] * in.y[i];
-    swxy += w[i] * in.x[i] * in.y[i];
-  }
-  const double n11 = swxx + in.prior_info;
-  const double det = sw * n11 - swx * swx;
-  if (!(det > 0)) return;
-  *a = (n11 * swy - swx * swxy) / det;
-  *b = (sw * swxy - swx * swy) / det;
+  WeightedLine line;
+  if (!FitWeightedLine(in.x, in.y, w, 1.0, in.prior_info, &line)) return;
+  *a = line.a;
+  *b = line.b;
 }
 
 /// EM from (a, b, s2); returns the log-likelihood and the outlier probabilities.
