@@ -12,8 +12,9 @@
 #
 # Seeds: the scenario file's own seed plus each offset in SEED_OFFSETS
 # (default "0 100 200"); the seed drives the sensor noise and the random
-# targets of the excitation flights. The tuning set is indoor_3uav with its
-# file seed (offset 0); every other row is held out (docs/results.md).
+# targets of the excitation flights. The tuning set is indoor_3uav, corridor
+# and exploration with their file seeds (offset 0); every other seed and
+# scenario is held out (docs/results.md).
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -69,8 +70,9 @@ stats() {
   echo
   preset="${IMPERFECTIONS:-as in each scenario file (simulator default)}"
   echo "Simulator preset: $preset. Seeds: each scenario's"
-  echo "file seed plus the offsets ${SEED_OFFSETS}. Tuning set: \`indoor_3uav\` with its file seed;"
-  echo "every other row is held out. Per drone over the seeds: APE RMSE of the position after"
+  echo "file seed plus the offsets ${SEED_OFFSETS}. Tuning set: \`indoor_3uav\`, \`corridor\` and"
+  echo "\`exploration\` with their file seeds; every other seed and scenario is held out. Per drone over the"
+  echo "seeds: APE RMSE of the position after"
   echo "SE(3) alignment as mean +- sample std (min-max) [m], mean position NEES (expected 3) with"
   echo "its range, and the mean of the per-run median per-scan time [ms]."
 } > "$DOC"

@@ -17,7 +17,9 @@ namespace {
 
 struct Cell {
   std::vector<Eigen::Vector3d> points_in_G;
+  std::vector<float> observed_ranges_m;  // parallel to points_in_G (0 = unknown)
 };
+
 
 // Squared distance from `q` to the cell box [lo, lo + size) on each axis.
 inline double BoxSquaredDistance(const Eigen::Vector3d& q, const Eigen::Vector3d& lo,
@@ -33,7 +35,8 @@ inline double BoxSquaredDistance(const Eigen::Vector3d& q, const Eigen::Vector3d
 }
 
 // Inserts (p, d2) into `out`, kept sorted ascending and at most k long.
-inline void PushCandidate(const Eigen::Vector3d& p, double d2, int k, std::vector<Neighbor>* out) {
+inline void PushCandidate(const Eigen::Vector3d& p, double d2, float range, int k,
+                          std::vector<Neighbor>* out) {
   const int n = static_cast<int>(out->size());
   if (n == k && d2 >= (*out)[n - 1].squared_distance_m2) return;
   if (n < k) out->emplace_back();
@@ -44,6 +47,7 @@ inline void PushCandidate(const Eigen::Vector3d& p, double d2, int k, std::vecto
   }
   (*out)[i].point_in_G = p;
   (*out)[i].squared_distance_m2 = d2;
+  (*out)[i].observed_range_m = range;
 }
 
 // The 26 neighbours of a cell ordered by how many axes they are offset on.
@@ -111,7 +115,7 @@ LocalMap::~LocalMap() = default;
 LocalMap::LocalMap(LocalMap&&) noexcept = default;
 LocalMap& LocalMap::operator=(LocalMap&&) noexcept = default;
 
-bool LocalMap::Insert(const Eigen::Vector3d& point_in_G) {
+bool LocalMap::Insert(const Eigen::Vector3d& point_in_G, double observed_range_m) {
   Impl& m = *impl_;
   if (!point_in_G.allFinite()) return false;
   if ((point_in_G - m.center).cwiseAbs().maxCoeff() > options_.half_extent_m) return false;
@@ -119,14 +123,23 @@ bool LocalMap::Insert(const Eigen::Vector3d& point_in_G) {
   (void)inserted;
   if (leaf->second >= static_cast<uint32_t>(options_.max_points_per_leaf)) return false;
   ++leaf.value();
-  m.cells[VoxelKeyOf(point_in_G, m.inv_cell)].points_in_G.push_back(point_in_G);
+  Cell& cell = m.cells[VoxelKeyOf(point_in_G, m.inv_cell)];
+  cell.points_in_G.push_back(point_in_G);
+  cell.observed_ranges_m.push_back(
+      std::isfinite(observed_range_m) && observed_range_m > 0.0 ? static_cast<float>(observed_range_m)
+                                                                : 0.0f);
   ++m.num_points;
   return true;
 }
 
-int LocalMap::Insert(const std::vector<Eigen::Vector3d>& points_in_G) {
+int LocalMap::Insert(const std::vector<Eigen::Vector3d>& points_in_G,
+                     const std::vector<double>* observed_ranges_m) {
+  CHECK(observed_ranges_m == nullptr || observed_ranges_m->size() == points_in_G.size());
   int added = 0;
-  for (const Eigen::Vector3d& p : points_in_G) added += Insert(p) ? 1 : 0;
+  for (size_t i = 0; i < points_in_G.size(); ++i) {
+    const double range = observed_ranges_m == nullptr ? 0.0 : (*observed_ranges_m)[i];
+    added += Insert(points_in_G[i], range) ? 1 : 0;
+  }
   return added;
 }
 
@@ -179,9 +192,10 @@ int LocalMap::KNearest(const Eigen::Vector3d& q_in_G, int k, std::vector<Neighbo
     if (static_cast<int>(out->size()) == k && box2 >= out->back().squared_distance_m2) return;
     const auto it = m.cells.find(key);
     if (it == m.cells.end()) return;
-    for (const Eigen::Vector3d& p : it->second.points_in_G) {
-      const double d2 = (p - q_in_G).squaredNorm();
-      if (d2 <= radius2) PushCandidate(p, d2, k, out);
+    const Cell& cell = it->second;
+    for (size_t i = 0; i < cell.points_in_G.size(); ++i) {
+      const double d2 = (cell.points_in_G[i] - q_in_G).squaredNorm();
+      if (d2 <= radius2) PushCandidate(cell.points_in_G[i], d2, cell.observed_ranges_m[i], k, out);
     }
   };
   for (int32_t r = 0;; ++r) {
@@ -228,7 +242,8 @@ size_t LocalMap::MemoryBytes() const {
                  m.leaf_counts.bucket_count() * (sizeof(VoxelKey) + sizeof(uint32_t) + 8);
   for (const auto& [key, cell] : m.cells) {
     (void)key;
-    bytes += cell.points_in_G.capacity() * sizeof(Eigen::Vector3d);
+    bytes += cell.points_in_G.capacity() * sizeof(Eigen::Vector3d) +
+             cell.observed_ranges_m.capacity() * sizeof(float);
   }
   return bytes;
 }

@@ -183,19 +183,23 @@ void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
   // at the initial pose: R_G_b = I, p_b_in_G = 0 (G is the IMU frame at the
   // window's end), without motion distortion.
   std::vector<Eigen::Vector3d> points_in_G;
+  std::vector<double> ranges;  // observation ranges (from the body origin)
   for (const PendingScan& pending : im.static_start_scans) {
     if (pending.scan.stamp_ns < window_start_ns || pending.end_ns > im.initialization.stamp_ns) {
       continue;
     }
     im.preprocess->Run(pending.scan, &im.points_in_b);
     if (static_cast<int>(im.points_in_b.size()) < options_.min_scan_points) continue;
-    for (const PointXYZT& p : im.points_in_b) points_in_G.push_back(p.p_in_b);
+    for (const PointXYZT& p : im.points_in_b) {
+      points_in_G.push_back(p.p_in_b);
+      ranges.push_back(p.p_in_b.norm());
+    }
     ++counters_.scans_seeding_map;
   }
   im.static_start_scans.clear();
   if (points_in_G.empty()) return;
   im.map.UpdateCenter(Eigen::Vector3d::Zero());
-  im.map.Insert(points_in_G);
+  im.map.Insert(points_in_G, &ranges);
 }
 
 Status Odometry::Flush() {
@@ -217,7 +221,9 @@ int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const 
                          std::vector<Eigen::Vector3d>* registered_out) {
   const Eigen::Matrix3d R_G_b = x.q_G_b.toRotationMatrix();
   std::vector<Eigen::Vector3d> registered;
+  std::vector<double> ranges;  // from the body origin: the LiDAR's within its lever arm
   registered.reserve(points_in_b.size());
+  ranges.reserve(points_in_b.size());
   int num_excluded = 0;
   for (const Eigen::Vector3d& p : points_in_b) {
     bool inside = false;
@@ -229,9 +235,10 @@ int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const 
       continue;
     }
     registered.push_back(R_G_b * p + x.p_b_in_G);
+    ranges.push_back(p.norm());
   }
   impl_->map.UpdateCenter(x.p_b_in_G);
-  impl_->map.Insert(registered);
+  impl_->map.Insert(registered, &ranges);
   if (registered_out != nullptr) *registered_out = std::move(registered);
   return num_excluded;
 }

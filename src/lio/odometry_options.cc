@@ -18,6 +18,10 @@ OdometryOptions OdometryOptionsFor(const LidarOptions& lidar) {
       options.map.leaf_size_m = 0.5;
       break;
   }
+  // The plane fit's normal noise model (for the noisy-plane rule) uses
+  // the sensor's datasheet precision (plane_fit.h, scan_association.h).
+  options.association.plane.map_range_stddev_m = lidar.range_noise_stddev_m;
+  options.association.plane.map_angular_stddev_deg = lidar.angular_precision_deg;
   // Keep what the sensor can see (FAST-LIO det_range), at least 20 m.
   options.map.half_extent_m = std::max(20.0, lidar.max_range_m);
   return options;

@@ -9,8 +9,9 @@
 namespace swarmlio::lio {
 namespace {
 
-template <class GetPoint>
-PlaneFitStatus FitImpl(int n, const GetPoint& get, double farthest_sq_distance_m2,
+template <class GetPoint, class GetRange>
+PlaneFitStatus FitImpl(int n, const GetPoint& get, const GetRange& get_range,
+                       double farthest_sq_distance_m2,
                        const PlaneFitOptions& options, Plane* plane) {
   CHECK(plane != nullptr);
   if (n < options.min_neighbors || n < 3) return PlaneFitStatus::kTooFewPoints;
@@ -55,6 +56,15 @@ PlaneFitStatus FitImpl(int n, const GetPoint& get, double farthest_sq_distance_m
     sum_sq += r * r;
   }
   if (!(max_abs <= options.max_point_to_plane_m)) return PlaneFitStatus::kNotPlanar;
+  const double angular_rad = options.map_angular_stddev_deg * (M_PI / 180.0);
+  double sum_var = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double r = get_range(i);
+    sum_var += options.map_range_stddev_m * options.map_range_stddev_m +
+               r * r * angular_rad * angular_rad;
+  }
+  plane->normal_stddev_rad = std::sqrt(sum_var / (static_cast<double>(n) * n * lambda(1)));
+  plane->tilt_axis_in_G = eig.eigenvectors().col(1).normalized();
   plane->normal_in_G = normal;
   plane->offset_m = offset;
   plane->max_abs_residual_m = max_abs;
@@ -87,7 +97,7 @@ PlaneFitStatus FitPlane(const std::vector<Eigen::Vector3d>& points,
                         Plane* plane) {
   return FitImpl(
       static_cast<int>(points.size()), [&](int i) -> const Eigen::Vector3d& { return points[i]; },
-      farthest_sq_distance_m2, options, plane);
+      [](int) { return 0.0; }, farthest_sq_distance_m2, options, plane);
 }
 
 PlaneFitStatus FitPlane(const std::vector<Neighbor>& neighbors, const PlaneFitOptions& options,
@@ -96,8 +106,8 @@ PlaneFitStatus FitPlane(const std::vector<Neighbor>& neighbors, const PlaneFitOp
   for (const Neighbor& nb : neighbors) farthest = std::max(farthest, nb.squared_distance_m2);
   return FitImpl(
       static_cast<int>(neighbors.size()),
-      [&](int i) -> const Eigen::Vector3d& { return neighbors[i].point_in_G; }, farthest, options,
-      plane);
+      [&](int i) -> const Eigen::Vector3d& { return neighbors[i].point_in_G; },
+      [&](int i) { return neighbors[i].observed_range_m; }, farthest, options, plane);
 }
 
 }  // namespace swarmlio::lio

@@ -31,6 +31,7 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
   const std::vector<Eigen::Vector3d>& points = *points_in_b_;
   stats_.num_points = static_cast<int>(points.size());
   out->reserve(points.size());
+  planes_.clear();
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d q_in_G = R_G_b * points[i] + p_b_in_G;
     CachedPlane& cached = cache_[i];
@@ -55,10 +56,52 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
     c.offset_m = cached.plane.offset_m;
     c.weight = weight;
     out->push_back(c);
+    planes_.push_back(&cached.plane);
+  }
+  if (options_.max_normal_stddev_rad > 0.0) DropTiltedPlanesAlongNoiseDominatedDirections(out);
+  for (const PlaneCorrespondence& c : *out) {
     stats_.normal_information += c.normal_in_G * c.normal_in_G.transpose();
   }
   stats_.num_correspondences = static_cast<int>(out->size());
   return Status::Ok();
+}
+
+void ScanAssociator::DropTiltedPlanesAlongNoiseDominatedDirections(
+    std::vector<PlaneCorrespondence>* out) {
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d spurious = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < out->size(); ++i) {
+    const Eigen::Vector3d& n = (*out)[i].normal_in_G;
+    const Plane& plane = *planes_[i];
+    information += n * n.transpose();
+    spurious += (plane.normal_stddev_rad * plane.normal_stddev_rad) *
+                (plane.tilt_axis_in_G * plane.tilt_axis_in_G.transpose());
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(information);
+  Eigen::Vector3d weak[3];
+  int num_weak = 0;
+  for (int j = 0; j < 3; ++j) {
+    const Eigen::Vector3d e = eig.eigenvectors().col(j);
+    if (eig.eigenvalues()(j) < options_.spurious_information_ratio * e.dot(spurious * e)) {
+      weak[num_weak++] = e;
+    }
+  }
+  if (num_weak == 0) return;
+  size_t kept = 0;
+  for (size_t i = 0; i < out->size(); ++i) {
+    const Plane& plane = *planes_[i];
+    bool drop = false;
+    for (int j = 0; j < num_weak; ++j) {
+      drop |= plane.normal_stddev_rad * std::abs(plane.tilt_axis_in_G.dot(weak[j])) >
+              options_.max_normal_stddev_rad;
+    }
+    if (drop) {
+      ++stats_.num_tilt_gated;
+      continue;
+    }
+    (*out)[kept++] = (*out)[i];
+  }
+  out->resize(kept);
 }
 
 }  // namespace swarmlio::lio

@@ -180,5 +180,19 @@ TEST(LocalMapTest, OptionsValidate) {
   EXPECT_NE(o.Validate().find("leaf_size_m"), std::string::npos);
 }
 
+TEST(LocalMapTest, KNearestReturnsTheRangeEachPointWasObservedFrom) {
+  LocalMap map(LocalMapOptions{});
+  const std::vector<Eigen::Vector3d> points = {{0.1, 0.1, 0.1}, {1.1, 0.1, 0.1}, {2.1, 0.1, 0.1}};
+  const std::vector<double> ranges = {12.5, -1.0, std::nan("")};  // invalid -> 0 (unknown)
+  ASSERT_EQ(map.Insert(points, &ranges), 3);
+  EXPECT_TRUE(map.Insert(Eigen::Vector3d(3.1, 0.1, 0.1)));  // no range given -> 0
+  std::vector<Neighbor> nn;
+  ASSERT_EQ(map.KNearest(Eigen::Vector3d(1.6, 0.1, 0.1), 4, &nn), 4);
+  for (const Neighbor& nb : nn) {
+    const bool observed = nb.point_in_G.x() < 0.5;
+    EXPECT_FLOAT_EQ(nb.observed_range_m, observed ? 12.5f : 0.0f) << nb.point_in_G.transpose();
+  }
+}
+
 }  // namespace
 }  // namespace swarmlio::lio

@@ -135,5 +135,72 @@ TEST(PlaneFitTest, OptionsValidate) {
   EXPECT_NE(options.Validate().find("max_point_to_plane_m"), std::string::npos);
 }
 
+// Five neighbours on z = 0 in a strip 2 m long (x) and +-0.1 m wide (y), all
+// observed from `range_m`.
+std::vector<Neighbor> Strip(double range_m, double noise_m, std::mt19937* rng) {
+  std::normal_distribution<double> noise(0.0, noise_m);
+  const double xs[5] = {-1.0, -0.5, 0.0, 0.5, 1.0};
+  const double ys[5] = {0.1, -0.1, 0.0, -0.1, 0.1};  // uncorrelated with x
+  std::vector<Neighbor> strip;
+  for (int i = 0; i < 5; ++i) {
+    Neighbor nb;
+    nb.point_in_G = Eigen::Vector3d(xs[i], ys[i], noise_m > 0.0 ? noise(*rng) : 0.0);
+    nb.squared_distance_m2 = 0.5;
+    nb.observed_range_m = range_m;
+    strip.push_back(nb);
+  }
+  return strip;
+}
+
+PlaneFitOptions StripNoise() {
+  PlaneFitOptions o;
+  o.max_neighbor_sq_distance_m2 = 1.0;
+  o.map_range_stddev_m = 0.02;
+  o.map_angular_stddev_deg = 0.15;
+  return o;
+}
+
+TEST(PlaneFitTest, NormalUncertaintyScalesWithTheObservationRange) {
+  std::mt19937 rng(3);
+  Plane plane;
+  // lambda_mid = mean y^2 = 0.008 m^2. From 2 m: sigma_i = 0.0207 m, sigma_n =
+  // 0.0207 / sqrt(5 * 0.008) = 0.103 rad. From 30 m: 0.081 m, 0.40 rad.
+  const double angular = 0.15 * M_PI / 180.0;
+  ASSERT_EQ(FitPlane(Strip(2.0, 0.0, &rng), StripNoise(), &plane), PlaneFitStatus::kOk);
+  EXPECT_NEAR(plane.normal_stddev_rad,
+              std::sqrt((0.02 * 0.02 + 4.0 * angular * angular) / (5.0 * 0.008)), 1e-9);
+  // The strip is narrow along y: the uncertain tilt moves the normal along y.
+  EXPECT_NEAR(std::abs(plane.tilt_axis_in_G.y()), 1.0, 1e-9);
+  ASSERT_EQ(FitPlane(Strip(30.0, 0.0, &rng), StripNoise(), &plane), PlaneFitStatus::kOk);
+  EXPECT_NEAR(plane.normal_stddev_rad, 0.40, 0.01);
+  // An unknown range (0) counts as range noise only.
+  ASSERT_EQ(FitPlane(Strip(0.0, 0.0, &rng), StripNoise(), &plane), PlaneFitStatus::kOk);
+  EXPECT_NEAR(plane.normal_stddev_rad, 0.02 / std::sqrt(5.0 * 0.008), 1e-9);
+}
+
+TEST(PlaneFitTest, ModelledNormalStddevMatchesTheScatterOfFittedNormals) {
+  // Points with the modelled noise (range 10 m: sigma = sqrt(0.02^2 +
+  // (10 * 0.15 deg)^2) = 0.033 m): the RMS of tilt / sigma_n over many fits
+  // is 1 when sigma_n is right (a factor sqrt(2) off fails the band).
+  std::mt19937 rng(11);
+  const double angular = 0.15 * M_PI / 180.0;
+  const double sigma = std::sqrt(0.02 * 0.02 + 100.0 * angular * angular);
+  PlaneFitOptions o = StripNoise();
+  o.max_point_to_plane_m = 1.0;
+  double sum_sq = 0.0;
+  int n = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    Plane plane;
+    ASSERT_EQ(FitPlane(Strip(10.0, sigma, &rng), o, &plane), PlaneFitStatus::kOk);
+    // Tilt about the strip's long axis x: the normal's y component.
+    const double tilt = std::atan2(plane.normal_in_G.y(), std::abs(plane.normal_in_G.z()));
+    sum_sq += (tilt / plane.normal_stddev_rad) * (tilt / plane.normal_stddev_rad);
+    ++n;
+  }
+  const double rms = std::sqrt(sum_sq / n);
+  EXPECT_GT(rms, 0.85);
+  EXPECT_LT(rms, 1.2);
+}
+
 }  // namespace
 }  // namespace swarmlio::lio

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <memory>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,45 @@ struct Case {
   int drone;
   double max_rmse_m;
 };
+
+// configs/scenarios/<name>.yaml with its scenario seed (the first `seed: N`)
+// replaced by `seed`: a held-out seed of the scenario.
+void LoadScenarioWithSeed(const std::string& name, int seed, sim::Scenario* scenario) {
+  const std::string path = std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/" + name + ".yaml";
+  std::ifstream file(path);
+  ASSERT_TRUE(file.good()) << path;
+  std::stringstream text;
+  text << file.rdbuf();
+  const std::string original = text.str();
+  const std::string yaml = std::regex_replace(original, std::regex("seed: [0-9]+"),
+                                              "seed: " + std::to_string(seed),
+                                              std::regex_constants::format_first_only);
+  ASSERT_NE(yaml, original) << "no `seed:` in " << path;
+  const Status parsed = sim::ParseScenario(yaml, path, scenario);
+  ASSERT_TRUE(parsed.ok()) << parsed.message();
+  ASSERT_EQ(scenario->imperfections, sim::ImperfectionPreset::kRealistic);
+}
+
+// Runs drone `index` of `simulator` through the odometry with the calibration
+// the simulator hands over (with its error, not the truth).
+void RunWithGivenCalibration(sim::Simulator* simulator, const sim::DroneConfig& d, int index,
+                             replay::ConsistencyStats* consistency) {
+  lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+  const sim::SensorCalibration given = sim::GivenCalibration(d);
+  options.imu_time_offset_s = given.imu_time_offset_s;
+  LidarOptions lidar = d.lidar.sensor;
+  lidar.R_imu_lidar = given.R_imu_lidar;
+  lidar.p_lidar_in_imu_m = given.p_lidar_in_imu_m;
+  std::unique_ptr<lio::Odometry> odometry;
+  ASSERT_TRUE(lio::Odometry::Create(options, lidar, &odometry).ok());
+  OdometrySink sink(odometry.get());
+  sim::DroneStats stats;
+  ASSERT_TRUE(simulator->RunDrone(index, &sink, &stats).ok());
+  ASSERT_TRUE(odometry->Flush().ok());
+  sink.Collect();
+  ASSERT_TRUE(
+      replay::EvaluateConsistency(sink.scans, sink.ground_truth, 0.05, consistency).ok());
+}
 
 TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
   sim::Scenario scenario;
@@ -161,21 +201,9 @@ TEST(OdometryEndToEnd, StaticStartScansSeedTheMap) {
 // position NEES of every drone within [0.3, 3] x its expected 3, and the
 // honest-accuracy targets (Mid-360 <= 3 cm, Avia <= 6 cm).
 TEST(OdometryEndToEnd, ConsistentOnTheRealisticSimulatorOnAHeldOutSeed) {
-  const std::string path =
-      std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml";
-  std::ifstream file(path);
-  ASSERT_TRUE(file.good());
-  std::stringstream text;
-  text << file.rdbuf();
-  std::string yaml = text.str();
-  const std::string kSeedLine = "\n  seed: 1\n";
-  const std::size_t seed_at = yaml.find(kSeedLine);
-  ASSERT_NE(seed_at, std::string::npos);
-  yaml.replace(seed_at, kSeedLine.size(), "\n  seed: 7\n");
   sim::Scenario scenario;
-  const Status parsed = sim::ParseScenario(yaml, path, &scenario);
-  ASSERT_TRUE(parsed.ok()) << parsed.message();
-  ASSERT_EQ(scenario.imperfections, sim::ImperfectionPreset::kRealistic);
+  LoadScenarioWithSeed("indoor_3uav", 7, &scenario);
+  if (HasFatalFailure()) return;
   sim::SimulationConfig config = scenario.simulation_config();
   config.duration_s = 40.0;
   config.num_threads = 1;
@@ -184,23 +212,9 @@ TEST(OdometryEndToEnd, ConsistentOnTheRealisticSimulatorOnAHeldOutSeed) {
   for (const Case c : {Case{0, 0.03}, Case{1, 0.03}, Case{2, 0.06}}) {
     const sim::DroneConfig& d = drones[c.drone];
     SCOPED_TRACE(d.name);
-    lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
-    // The calibration handed to the estimator (with its error), not the truth.
-    const sim::SensorCalibration given = sim::GivenCalibration(d);
-    options.imu_time_offset_s = given.imu_time_offset_s;
-    LidarOptions lidar = d.lidar.sensor;
-    lidar.R_imu_lidar = given.R_imu_lidar;
-    lidar.p_lidar_in_imu_m = given.p_lidar_in_imu_m;
-    std::unique_ptr<lio::Odometry> odometry;
-    ASSERT_TRUE(lio::Odometry::Create(options, lidar, &odometry).ok());
-    OdometrySink sink(odometry.get());
-    sim::DroneStats stats;
-    ASSERT_TRUE(simulator.RunDrone(c.drone, &sink, &stats).ok());
-    ASSERT_TRUE(odometry->Flush().ok());
-    sink.Collect();
     replay::ConsistencyStats consistency;
-    ASSERT_TRUE(
-        replay::EvaluateConsistency(sink.scans, sink.ground_truth, 0.05, &consistency).ok());
+    RunWithGivenCalibration(&simulator, d, c.drone, &consistency);
+    if (HasFatalFailure()) return;
     std::printf("[ figures  ] %s (realistic, seed 7, 40 s): position RMSE %.4f m, rotation RMSE "
                 "%.3f deg, mean position NEES %.2f\n",
                 d.name.c_str(), consistency.position_rmse_m, consistency.rotation_rmse_deg,

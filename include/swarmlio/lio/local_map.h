@@ -10,7 +10,9 @@
 // leaf voxel (side leaf_size_m, [k*leaf, (k+1)*leaf) per axis) holds fewer
 // than max_points_per_leaf points; otherwise it is dropped (first come, first
 // kept). Points outside the current box (below) and non-finite points are
-// dropped too.
+// dropped too. Each point keeps the LiDAR range it was observed from
+// (returned with it by KNearest): a LiDAR's angular noise displaces a point by
+// range x angle, which the plane fit's normal noise model uses.
 //
 // Bounding (FAST-LIO cube_side_length / det_range): the map keeps the axis
 // aligned cube of half side half_extent_m around the last UpdateCenter()
@@ -83,11 +85,14 @@ class LocalMap {
   LocalMap(LocalMap&&) noexcept;
   LocalMap& operator=(LocalMap&&) noexcept;
 
-  /// Adds `point_in_G` unless its leaf voxel is full, it is outside the box
-  /// or not finite. Returns true when added.
-  bool Insert(const Eigen::Vector3d& point_in_G);
-  /// Adds each point in order; returns how many were added.
-  int Insert(const std::vector<Eigen::Vector3d>& points_in_G);
+  /// Adds `point_in_G`, observed from `observed_range_m` (0 = unknown), unless
+  /// its leaf voxel is full, it is outside the box or not finite. Returns true
+  /// when added.
+  bool Insert(const Eigen::Vector3d& point_in_G, double observed_range_m = 0.0);
+  /// Adds each point in order; `observed_ranges_m` (may be null) parallel to
+  /// the points. Returns how many were added.
+  int Insert(const std::vector<Eigen::Vector3d>& points_in_G,
+             const std::vector<double>* observed_ranges_m = nullptr);
 
   /// Moves the box centre to the drone position `p_b_in_G` (initially the
   /// origin); prunes when it moved more than prune_distance_m since the last

@@ -19,6 +19,15 @@
 //                     sqrt(lambda_mid) < min_plane_extent_m), normal undefined;
 //   kNotPlanar:       some neighbour is farther than max_point_to_plane_m from
 //                     the plane (FAST-LIO esti_plane threshold 0.1 m).
+// Normal uncertainty (reported, not a test; the scan association uses it):
+// each neighbour's noise along the normal is taken as
+//   sigma_i^2 = map_range_stddev^2 + (r_i map_angular_stddev)^2,
+// r_i the range it was observed from (Neighbor::observed_range_m; at grazing
+// incidence a beam-direction error moves the point along the normal by
+// range x angle), and the fitted normal tilts about the plane's narrower
+// in-plane axis (it moves n along tilt_axis_in_G, the narrower in-plane axis)
+// with stddev sigma_n = sqrt(mean_i sigma_i^2 / (k lambda_mid)), the
+// least-squares slope error (docs/lio.md, "Noisy map planes").
 // Orientation: n is a unit vector with d <= 0 (the origin of G lies on the
 // negative side; for d == 0 the first non-zero component of n is positive),
 // so the same neighbours always give the same (n, d).
@@ -38,6 +47,8 @@ struct PlaneFitOptions {
   double max_neighbor_sq_distance_m2 = 5.0;   // farthest neighbour to the query [m^2]
   double max_point_to_plane_m = 0.1;          // planarity: every neighbour within [m]
   double min_plane_extent_m = 0.01;           // sqrt of the middle scatter eigenvalue [m]
+  double map_range_stddev_m = 0.02;     // range noise of the map points, 1 sigma [m]
+  double map_angular_stddev_deg = 0.0;  // LiDAR angular precision, 1 sigma [deg]
 
   template <class V>
   void VisitFields(V&& v) {
@@ -51,6 +62,10 @@ struct PlaneFitOptions {
       FieldSpec::Positive("m", "every neighbour must be this close to the plane"));
     v("min_plane_extent_m", min_plane_extent_m,
       FieldSpec::AtLeast(0.0, "m", "reject collinear neighbours (in-plane RMS spread below)"));
+    v("map_range_stddev_m", map_range_stddev_m,
+      FieldSpec::AtLeast(0.0, "m", "range noise of the map points (1 sigma)"));
+    v("map_angular_stddev_deg", map_angular_stddev_deg,
+      FieldSpec::InRange(0.0, 10.0, "deg", "angular precision of the LiDAR (1 sigma)"));
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };
@@ -65,6 +80,10 @@ struct Plane {
   double max_abs_residual_m = 0.0;       // max_i |n^T q_i + d| over the neighbours [m]
   double rms_residual_m = 0.0;           // RMS of n^T q_i + d [m]
   double curvature = 0.0;  // lambda_min / (sum of eigenvalues), 0 = flat, 1/3 = isotropic
+  double normal_stddev_rad = 0.0;  // sigma_n: modelled tilt stddev of n (above) [rad]
+  // Unit in-plane axis along which the uncertain tilt moves n (the scatter's
+  // middle eigenvector: the plane's narrower in-plane extent).
+  Eigen::Vector3d tilt_axis_in_G = Eigen::Vector3d::UnitX();
 
   /// Signed distance of `q_in_G` to the plane [m].
   double SignedDistance(const Eigen::Vector3d& q_in_G) const {

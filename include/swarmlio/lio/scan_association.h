@@ -32,7 +32,8 @@
 namespace swarmlio::lio {
 
 /// Plane-fit defaults for scan association, stricter than FAST-LIO's (0.1 m
-/// planarity, 5 m^2 neighbour reach, no collinearity test): with sparse maps
+/// planarity, 5 m^2 neighbour reach, no collinearity or normal-uncertainty
+/// test): with sparse maps
 /// (one Livox Avia scan) looser planes tilted the attitude by ~0.4-1 deg while
 /// static (docs/lio.md, "Plane acceptance").
 inline PlaneFitOptions AssociationPlaneFitDefaults() {
@@ -60,6 +61,19 @@ struct AssociationOptions {
   // sum_n n_n n_n^T over its correspondences is below this (Swarm-LIO2
   // degeneration_thresh: code default 30, 10 in its Mid-360 config) [-].
   double degeneracy_threshold = 30.0;
+  // Noisy map planes (docs/lio.md): a plane whose normal may tilt by sigma_n
+  // (PlaneFitOptions' noise model) about its narrower in-plane axis u adds
+  // spurious information sigma_n^2 u u^T. Along an eigen-direction e of
+  // I = sum n n^T where I is below spurious_information_ratio times the
+  // expected spurious sum_n sigma_n^2 (u_n^T e)^2, the planes with
+  // sigma_n |u_n^T e| > max_normal_stddev_rad are dropped (a corridor's
+  // axis); elsewhere every plane is kept (far planes are the only
+  // information in open spaces). The ratio is large because the model
+  // under-counts: the planarity test keeps the fits whose tilt absorbed the
+  // noise, and neighbouring planes share map points. Chosen on the tuning
+  // set {indoor_3uav seed 1, corridor seed 3, exploration seed 4}; 0 = off.
+  double max_normal_stddev_rad = 0.2;
+  double spurious_information_ratio = 30.0;
   PlaneFitOptions plane = AssociationPlaneFitDefaults();
 
   template <class V>
@@ -74,6 +88,14 @@ struct AssociationOptions {
     v("research_distance_m", research_distance_m,
       FieldSpec::AtLeast(0.0, "m",
                          "repeat a point's neighbour search when it moved this far; 0 = always"));
+    v("max_normal_stddev_rad", max_normal_stddev_rad,
+      FieldSpec::AtLeast(0.0, "rad",
+                         "along noise-dominated directions drop planes whose normal's tilt "
+                         "toward them exceeds this; 0 = off"));
+    v("spurious_information_ratio", spurious_information_ratio,
+      FieldSpec::AtLeast(1.0, "",
+                         "a direction is noise-dominated when its plane information is below "
+                         "this times the information normal tilt noise alone would give"));
     v("degeneracy_threshold", degeneracy_threshold,
       FieldSpec::AtLeast(0.0, "", "degenerate scan: smallest eigenvalue of sum n n^T below this"));
     v("plane", plane);
@@ -86,6 +108,7 @@ struct AssociationStats {
   int num_searched = 0;       // neighbour searches run in the last call
   int num_no_plane = 0;       // too few / too far neighbours, not planar
   int num_gated = 0;          // plane found, residual too large
+  int num_tilt_gated = 0;     // dropped along a noise-dominated direction
   int num_correspondences = 0;
   /// sum_n n_n n_n^T over the correspondences: how well the planes constrain
   /// the translation in each direction (see MinNormalInformation()).
@@ -117,11 +140,16 @@ class ScanAssociator {
     Plane plane;
   };
 
+  // Applies max_normal_stddev_rad (see AssociationOptions) to `out`, whose
+  // planes are planes_; counts the dropped ones.
+  void DropTiltedPlanesAlongNoiseDominatedDirections(std::vector<PlaneCorrespondence>* out);
+
   const LocalMap* map_;
   AssociationOptions options_;
   const std::vector<Eigen::Vector3d>* points_in_b_ = nullptr;
   std::vector<CachedPlane> cache_;
   std::vector<Neighbor> neighbors_;  // scratch
+  std::vector<const Plane*> planes_;  // scratch: the plane of each correspondence
   AssociationStats stats_;
 };
 

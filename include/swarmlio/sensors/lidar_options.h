@@ -54,6 +54,7 @@ struct LidarOptions {
   double blind_range_m = 0.5;           // closer points are dropped [m]
   double max_range_m = 450.0;           // farther points are dropped [m]
   double range_noise_stddev_m = 0.02;   // 1-sigma range error [m]
+  double angular_precision_deg = 0.0;   // 1-sigma beam direction error (datasheet); 0 = unknown [deg]
   TimestampUnit timestamp_unit = TimestampUnit::kNanosecond;
   Eigen::Matrix3d R_imu_lidar = Eigen::Matrix3d::Identity();   // rotation LiDAR -> IMU
   Eigen::Vector3d p_lidar_in_imu_m = Eigen::Vector3d::Zero();  // LiDAR origin in IMU frame [m]
@@ -86,6 +87,10 @@ struct LidarOptions {
     v("max_range_m", max_range_m, FieldSpec::Positive("m", "points farther are dropped"));
     v("range_noise_stddev_m", range_noise_stddev_m,
       FieldSpec::InRange(0.0, 1.0, "m", "1-sigma range noise (sensor model and simulator)"));
+    v("angular_precision_deg", angular_precision_deg,
+      FieldSpec::InRange(0.0, 5.0, "deg",
+                         "1-sigma beam direction error from the datasheet (estimator's noisy-plane "
+                         "rule); 0 = unknown"));
     v("timestamp_unit", timestamp_unit, FieldSpec::Doc("unit of the per-point time field"));
     v("R_imu_lidar", R_imu_lidar,
       FieldSpec::InRange(-1.0, 1.0, "", "rotation LiDAR -> IMU (FAST-LIO extrinsic_R)"));
