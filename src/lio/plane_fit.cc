@@ -64,7 +64,10 @@ PlaneFitStatus FitImpl(int n, const GetPoint& get, const GetRange& get_range,
                r * r * angular_rad * angular_rad;
   }
   plane->normal_stddev_rad = std::sqrt(sum_var / (static_cast<double>(n) * n * lambda(1)));
+  plane->normal_stddev_major_rad =
+      std::sqrt(sum_var / (static_cast<double>(n) * n * std::max(lambda(2), lambda(1))));
   plane->tilt_axis_in_G = eig.eigenvectors().col(1).normalized();
+  plane->centroid_in_G = centroid;
   plane->normal_in_G = normal;
   plane->offset_m = offset;
   plane->max_abs_residual_m = max_abs;
@@ -75,6 +78,13 @@ PlaneFitStatus FitImpl(int n, const GetPoint& get, const GetRange& get_range,
 }
 
 }  // namespace
+
+double Plane::TiltStddevToward(const Eigen::Vector3d& e) const {
+  const double along_minor = normal_stddev_rad * tilt_axis_in_G.dot(e);
+  const Eigen::Vector3d major = tilt_axis_in_G.cross(normal_in_G);
+  const double along_major = normal_stddev_major_rad * major.dot(e);
+  return std::sqrt(along_minor * along_minor + along_major * along_major);
+}
 
 const char* ToString(PlaneFitStatus status) {
   switch (status) {

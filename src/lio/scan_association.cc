@@ -1,6 +1,7 @@
 #include "swarmlio/lio/scan_association.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 namespace swarmlio::lio {
@@ -87,6 +88,7 @@ void ScanAssociator::DropTiltedPlanesAlongNoiseDominatedDirections(
     }
   }
   if (num_weak == 0) return;
+  const double k = options_.tilt_projection_sigma;
   size_t kept = 0;
   for (size_t i = 0; i < out->size(); ++i) {
     const Plane& plane = *planes_[i];
@@ -99,7 +101,35 @@ void ScanAssociator::DropTiltedPlanesAlongNoiseDominatedDirections(
       ++stats_.num_tilt_gated;
       continue;
     }
-    (*out)[kept++] = (*out)[i];
+    PlaneCorrespondence& c = (*out)[i];
+    if (k > 0.0) {
+      Eigen::Vector3d n = c.normal_in_G;
+      bool shrunk = false;
+      for (int j = 0; j < num_weak; ++j) {
+        // Shrink the lean l toward e to sqrt(max(0, l^2 - (k t_e)^2)): the
+        // information (n^T e)^2 loses what tilt noise of k t_e would add.
+        const double lean = n.dot(weak[j]);
+        const double noise = k * plane.TiltStddevToward(weak[j]);
+        if (noise <= 0.0) continue;
+        const double remaining = std::sqrt(std::max(0.0, lean * lean - noise * noise));
+        n -= (lean - std::copysign(remaining, lean)) * weak[j];
+        shrunk = true;
+      }
+      // A normal that loses more than half its length leaned mostly along
+      // noise-dominated directions by no more than its noise: the plane
+      // says little else and is dropped.
+      const double norm = n.norm();
+      if (shrunk && norm <= 0.5) {
+        ++stats_.num_tilt_gated;
+        continue;
+      }
+      if (shrunk) {
+        c.normal_in_G = n / norm;
+        c.offset_m = -c.normal_in_G.dot(plane.centroid_in_G);
+        ++stats_.num_tilt_projected;
+      }
+    }
+    (*out)[kept++] = c;
   }
   out->resize(kept);
 }

@@ -30,6 +30,7 @@ using internal::ComposeExtrinsic;
 using internal::SetProvenance;
 using internal::FixedExtrinsicCost;
 using internal::HeardTeammates;
+using internal::ObservationShare;
 using internal::Predict;
 using internal::PredictedTeammate;
 using internal::SwarmPart;
@@ -331,12 +332,10 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
   // flagged scan, relies on degenerate teammates.
   im.degenerate_average = 0.9 * im.degenerate_average + (scan.previous_scan_degenerate ? 0.1 : 0.0);
   const bool skip_degenerate = so.skip_degenerate_teammates && im.degenerate_average < 0.5;
-  // While this drone reports its scans degenerate, well-localized teammates
-  // do not fuse observations involving it (skip_degenerate_teammates): each
-  // one is used here only, at its full information.
-  const double share = so.skip_degenerate_teammates && scan.previous_scan_degenerate
-                           ? 1.0
-                           : so.observation_information_share;
+  // Each use of an observation takes its share (ObservationShare).
+  const auto share_with = [&](bool teammate_degenerate) {
+    return ObservationShare(so, scan.previous_scan_degenerate, teammate_degenerate);
+  };
   const double gate2 = so.gate_sigma * so.gate_sigma;
   const auto add = [&](std::unique_ptr<ceres::CostFunction> cost, int teammate_id,
                        const Eigen::Vector3d& innovation, const Eigen::Matrix3d& S) {
@@ -376,7 +375,8 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       const PredictedTeammate j = Predict(m, so.time_compensation ? age : 0.0);
       const GlobalExtrinsic& T = x->teammate(o.drone_id);
       auto factor = std::make_unique<ActiveObservationFactor>(
-          o.p_bj_in_bi, j.p_bj_in_Gj, Regularized<3>(o.covariance_m2) / share,
+          o.p_bj_in_bi, j.p_bj_in_Gj,
+          Regularized<3>(o.covariance_m2) / share_with(m.degenerated),
           Regularized<3>(j.cov_p), R_Gi_bi,
           T.R_Gi_Gj());
       const Eigen::Vector3d e = factor->Predict(x->ego, T) - o.p_bj_in_bi;
@@ -409,7 +409,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       ImuRetrodiction retrodiction;
       // The observer fused the same measurement actively: this use takes its
       // share of the information (SwarmOptions::observation_information_share).
-      const Eigen::Matrix3d Sigma_obs = Regularized<3>(p.cov) / share;
+      const Eigen::Matrix3d Sigma_obs = Regularized<3>(p.cov) / share_with(p.sender.degenerated);
       if (so.time_compensation) im.dead_reckoning.Retrodiction(p.stamp_ns, t_k, &retrodiction);
       auto factor = std::make_unique<PassiveObservationFactor>(
           p.p_bi_in_bj, so.time_compensation ? dt : 0.0, p.sender.q_Gj_bj.normalized().toRotationMatrix(),

@@ -16,6 +16,7 @@
 
 #include "swarmlio/lio/measurement_model.h"
 #include "swarmlio/state/swarm_state.h"
+#include "swarmlio/swarm/swarm_options.h"
 
 namespace swarmlio::swarm::internal {
 
@@ -89,6 +90,21 @@ Eigen::Matrix<double, N, N> Regularized(const Eigen::Matrix<double, N, N>& C, do
 // Mahalanobis distance^2 of h - z under S.
 inline double Mahalanobis2(const Eigen::Vector3d& e, const Eigen::Matrix3d& S) {
   return e.dot(S.ldlt().solve(e));
+}
+
+// The share of a mutual observation's information this drone takes
+// (docs/swarm.md "Information sharing"): observation_information_share, or
+// all of it while this drone's last scan was degenerate and the teammate's
+// (its state with the observation) was not. Such a teammate skips the
+// observation (skip_degenerate_teammates), so it is used here only. A
+// teammate that reports degeneracy itself may fuse it too (it skips only
+// while it is mostly well localized): the share stays, or both would take
+// it at full weight and the swarm would count it twice.
+inline double ObservationShare(const SwarmOptions& options, bool own_last_scan_degenerate,
+                               bool teammate_degenerate) {
+  return options.skip_degenerate_teammates && own_last_scan_degenerate && !teammate_degenerate
+             ? 1.0
+             : options.observation_information_share;
 }
 
 }  // namespace swarmlio::swarm::internal

@@ -178,6 +178,30 @@ TEST(PlaneFitTest, NormalUncertaintyScalesWithTheObservationRange) {
   EXPECT_NEAR(plane.normal_stddev_rad, 0.02 / std::sqrt(5.0 * 0.008), 1e-9);
 }
 
+TEST(PlaneFitTest, TiltTowardADirectionCombinesBothInPlaneAxes) {
+  std::mt19937 rng(5);
+  Plane plane;
+  ASSERT_EQ(FitPlane(Strip(10.0, 0.0, &rng), StripNoise(), &plane), PlaneFitStatus::kOk);
+  // lambda_mid = 0.008 m^2 (y), lambda_max = mean x^2 = 0.5 m^2 (x).
+  const double angular = 0.15 * M_PI / 180.0;
+  const double var = 0.02 * 0.02 + 100.0 * angular * angular;
+  EXPECT_NEAR(plane.TiltStddevToward(Eigen::Vector3d::UnitY()), std::sqrt(var / (5.0 * 0.008)),
+              1e-9);
+  EXPECT_NEAR(plane.TiltStddevToward(Eigen::Vector3d::UnitX()), std::sqrt(var / (5.0 * 0.5)),
+              1e-9);
+  EXPECT_NEAR(plane.TiltStddevToward(Eigen::Vector3d::UnitZ()), 0.0, 1e-9);  // along n
+  const Eigen::Vector3d diagonal = Eigen::Vector3d(1.0, 1.0, 0.0).normalized();
+  EXPECT_NEAR(plane.TiltStddevToward(diagonal),
+              std::sqrt(0.5 * var / (5.0 * 0.008) + 0.5 * var / (5.0 * 0.5)), 1e-9);
+  // The centroid: the strip moved to (3, -2, 1) has it there.
+  std::vector<Eigen::Vector3d> moved;
+  for (const Neighbor& nb : Strip(10.0, 0.0, &rng)) {
+    moved.push_back(nb.point_in_G + Eigen::Vector3d(3.0, -2.0, 1.0));
+  }
+  ASSERT_EQ(FitPlane(moved, 0.5, StripNoise(), &plane), PlaneFitStatus::kOk);
+  EXPECT_LT((plane.centroid_in_G - Eigen::Vector3d(3.0, -2.0, 1.0)).norm(), 1e-12);
+}
+
 TEST(PlaneFitTest, ModelledNormalStddevMatchesTheScatterOfFittedNormals) {
   // Points with the modelled noise (range 10 m: sigma = sqrt(0.02^2 +
   // (10 * 0.15 deg)^2) = 0.033 m): the RMS of tilt / sigma_n over many fits

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -40,26 +42,41 @@ std::vector<Eigen::Vector3d> CorridorPoints(double half_length, bool end_walls, 
 struct Result {
   AssociationStats stats;
   double x_information = 0.0;  // e_x^T sum n n^T e_x
+  double max_abs_residual_m = 0.0;  // of the scan points to their planes
+  double end_wall_x_information = 0.0;  // sum n_x^2 over normals with |n_x| > 0.7
 };
 
+// The association options of the tests: a Mid-360's 0.15 deg, the rule's
+// drop threshold and projection as given (0 = off).
+AssociationOptions RuleOptions(double max_normal_stddev_rad, double tilt_projection_sigma) {
+  AssociationOptions options;
+  options.plane.map_angular_stddev_deg = 0.15;
+  options.max_normal_stddev_rad = max_normal_stddev_rad;
+  options.tilt_projection_sigma = tilt_projection_sigma;
+  return options;
+}
+
 // Map points observed from `map_range_m` (noise along each surface's normal
-// of range x 0.15 deg), a noise-free scan from (0, 0, 1.5).
-Result Associate(bool end_walls, double map_range_m, double max_normal_stddev_rad) {
+// of range x 0.15 deg; the end walls from `end_wall_range_m`, 0 = the same),
+// a noise-free scan from (0, 0, 1.5).
+Result Associate(bool end_walls, double map_range_m, const AssociationOptions& options,
+                 double end_wall_range_m = 0.0) {
   LocalMapOptions map_options;
   map_options.leaf_size_m = 0.3;
   LocalMap map(map_options);
   std::mt19937 rng(7);
-  const double sigma = map_range_m * 0.15 * M_PI / 180.0;
-  std::normal_distribution<double> noise(0.0, sigma);
+  const double end_range = end_wall_range_m > 0.0 ? end_wall_range_m : map_range_m;
+  std::normal_distribution<double> noise(0.0, 1.0);
   std::vector<Eigen::Vector3d> mapped;
   std::vector<double> ranges;
   for (Eigen::Vector3d p : CorridorPoints(8.0, end_walls, 0.1)) {
     const bool wall_y = std::abs(std::abs(p.y()) - 1.2) < 1e-9;
     const bool end = std::abs(std::abs(p.x()) - 8.0) < 1e-9 && end_walls;
     const int axis = end ? 0 : wall_y ? 1 : 2;
-    p(axis) += noise(rng);
+    const double range = end ? end_range : map_range_m;
+    p(axis) += range * 0.15 * M_PI / 180.0 * noise(rng);
     mapped.push_back(p);
-    ranges.push_back(map_range_m);
+    ranges.push_back(range);
   }
   map.Insert(mapped, &ranges);
 
@@ -67,9 +84,6 @@ Result Associate(bool end_walls, double map_range_m, double max_normal_stddev_ra
   for (const Eigen::Vector3d& p : CorridorPoints(8.0, end_walls, 0.37)) {
     scan.push_back(p - Eigen::Vector3d(0.0, 0.0, 1.5));
   }
-  AssociationOptions options;
-  options.plane.map_angular_stddev_deg = 0.15;
-  options.max_normal_stddev_rad = max_normal_stddev_rad;
   ScanAssociator associator(&map, options);
   associator.Reset(&scan);
   SwarmState x;
@@ -79,13 +93,19 @@ Result Associate(bool end_walls, double map_range_m, double max_normal_stddev_ra
   Result r;
   r.stats = associator.stats();
   r.x_information = r.stats.normal_information(0, 0);
+  for (const PlaneCorrespondence& c : correspondences) {
+    const Eigen::Vector3d q = c.p_in_b + x.ego.p_b_in_G;
+    r.max_abs_residual_m = std::max(r.max_abs_residual_m, std::abs(c.normal_in_G.dot(q) + c.offset_m));
+    const double n_x = c.normal_in_G.x();
+    if (std::abs(n_x) > 0.7) r.end_wall_x_information += n_x * n_x;
+  }
   return r;
 }
 
 TEST(ScanAssociationTest, TiltedPlanesAreDroppedAlongACorridorAxis) {
   // Mapped from 25 m: 6.5 cm of noise on 0.3 m map leaves.
-  const Result off = Associate(/*end_walls=*/false, 25.0, 0.0);
-  const Result on = Associate(/*end_walls=*/false, 25.0, 0.2);
+  const Result off = Associate(/*end_walls=*/false, 25.0, RuleOptions(0.0, 0.0));
+  const Result on = Associate(/*end_walls=*/false, 25.0, RuleOptions(0.2, 0.0));
   std::printf("[ figures  ] corridor: %d correspondences, x information %.1f; with the rule %d "
               "(%d dropped), x information %.1f\n",
               off.stats.num_correspondences, off.x_information, on.stats.num_correspondences,
@@ -100,10 +120,56 @@ TEST(ScanAssociationTest, TiltedPlanesAreDroppedAlongACorridorAxis) {
 }
 
 TEST(ScanAssociationTest, NothingIsDroppedWhereTheAxisIsConstrained) {
-  // A room mapped from 3 m (1.9 cm of noise): its end walls constrain x.
-  const Result on = Associate(/*end_walls=*/true, 3.0, 0.2);
-  EXPECT_EQ(on.stats.num_tilt_gated, 0);
-  EXPECT_GT(on.x_information, 10.0);
+  // A room mapped from 3 m (0.8 cm of angular noise): its end walls constrain
+  // x; no plane is dropped and the projection leaves the end walls' normals.
+  const Result drop = Associate(/*end_walls=*/true, 3.0, RuleOptions(0.2, 0.0));
+  const Result project = Associate(/*end_walls=*/true, 3.0, RuleOptions(0.2, 3.0));
+  EXPECT_EQ(project.stats.num_tilt_gated, 0);
+  EXPECT_GT(project.x_information, 10.0);
+  EXPECT_NEAR(project.end_wall_x_information, drop.end_wall_x_information,
+              1e-3 * drop.end_wall_x_information);
+}
+
+TEST(ScanAssociationTest, KeptPlanesAreProjectedOffACorridorAxis) {
+  // The drop alone leaves the kept planes' tilts along the axis; projecting
+  // them (3 sigma) removes what noise made there and keeps every plane's
+  // information across the axis.
+  const Result drop = Associate(/*end_walls=*/false, 25.0, RuleOptions(0.2, 0.0));
+  const Result project = Associate(/*end_walls=*/false, 25.0, RuleOptions(0.2, 3.0));
+  std::printf("[ figures  ] corridor: x information %.2f dropping, %.3f also projecting (%d of %d "
+              "projected)\n",
+              drop.x_information, project.x_information, project.stats.num_tilt_projected,
+              project.stats.num_correspondences);
+  // (A plane whose normal leans mostly along the axis, within its noise, is
+  // dropped: it says little across the axis.)
+  EXPECT_GT(project.stats.num_correspondences, 0.9 * drop.stats.num_correspondences);
+  EXPECT_GT(project.stats.num_tilt_projected, project.stats.num_correspondences / 2);
+  EXPECT_LT(project.x_information, 0.1 * drop.x_information);
+  // The walls, floor and ceiling keep their information across the axis.
+  EXPECT_GT(project.stats.normal_information(1, 1), 0.9 * drop.stats.normal_information(1, 1));
+  EXPECT_GT(project.stats.normal_information(2, 2), 0.9 * drop.stats.normal_information(2, 2));
+  // A projected plane still passes through its neighbours: a scan point on
+  // the true surface is within the map noise of it (checked by the residual
+  // of the correspondences, below 3 x 6.5 cm).
+  EXPECT_LT(project.max_abs_residual_m, 0.2);
+}
+
+TEST(ScanAssociationTest, AnEndWallKeepsItsInformationAlongTheAxis) {
+  // Long walls mapped from 25 m, end walls 8 m away mapped from 3 m: the
+  // axis is constrained by the end walls only. The projection takes what the
+  // long walls' tilts added along it and nothing of the end walls'.
+  const Result drop = Associate(/*end_walls=*/true, 25.0, RuleOptions(0.2, 0.0), 3.0);
+  const Result project = Associate(/*end_walls=*/true, 25.0, RuleOptions(0.2, 3.0), 3.0);
+  std::printf("[ figures  ] corridor with end walls: x information %.2f dropping (end walls "
+              "%.2f), %.2f also projecting (end walls %.2f)\n",
+              drop.x_information, drop.end_wall_x_information, project.x_information,
+              project.end_wall_x_information);
+  EXPECT_GT(project.end_wall_x_information, 10.0);
+  // (Projections off the other directions may straighten an end wall's
+  // normal: its x information may grow, never shrink.)
+  EXPECT_GT(project.end_wall_x_information, 0.99 * drop.end_wall_x_information);
+  EXPECT_LT(project.x_information - project.end_wall_x_information,
+            0.1 * (drop.x_information - drop.end_wall_x_information));
 }
 
 }  // namespace

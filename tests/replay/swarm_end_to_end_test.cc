@@ -85,8 +85,11 @@ TEST_F(SwarmEndToEndTest, TeammatesKeepTheWallFacingAviaFromDrifting) {
     EXPECT_EQ(identified_swarm[i], 2);
     EXPECT_EQ(identified_single[i], 2);
   }
-  // uav1 (Avia) drifts alone, not with its teammates.
-  EXPECT_GT(single[0], 0.2);
+  // uav1 (Avia) drifts alone, not with its teammates. (Alone over 0.2 m
+  // before the noisy-plane projection, 0.19 m with it (lio.md "Noisy map
+  // planes"); with teammates 0.025 m.)
+  EXPECT_GT(single[0], 0.1);
+  EXPECT_GT(single[0], 4.0 * swarm[0]);
   EXPECT_LT(swarm[0], 0.05);
   // The observers (Mid-360) are no worse than alone (+10 %, +1 mm of slack
   // for millimetre-level figures).

@@ -84,6 +84,15 @@ struct Plane {
   // Unit in-plane axis along which the uncertain tilt moves n (the scatter's
   // middle eigenvector: the plane's narrower in-plane extent).
   Eigen::Vector3d tilt_axis_in_G = Eigen::Vector3d::UnitX();
+  // Tilt stddev of n toward the other in-plane axis (the scatter's largest
+  // eigenvector, tilt_axis_in_G x normal_in_G up to sign): the same formula
+  // with lambda_max [rad].
+  double normal_stddev_major_rad = 0.0;
+  Eigen::Vector3d centroid_in_G = Eigen::Vector3d::Zero();  // mean of the neighbours [m]
+
+  /// Modelled stddev of n^T e, the normal's tilt toward the unit vector `e`
+  /// (both in-plane axes) [rad].
+  double TiltStddevToward(const Eigen::Vector3d& e) const;
 
   /// Signed distance of `q_in_G` to the plane [m].
   double SignedDistance(const Eigen::Vector3d& q_in_G) const {

@@ -74,6 +74,13 @@ struct AssociationOptions {
   // set {indoor_3uav seed 1, corridor seed 3, exploration seed 4}; 0 = off.
   double max_normal_stddev_rad = 0.2;
   double spurious_information_ratio = 30.0;
+  // Along such a direction e, a kept plane whose normal leans toward e by
+  // less than tilt_projection_sigma times its modelled tilt stddev toward e
+  // (|n^T e| < k TiltStddevToward(e)) cannot be told from one parallel to e:
+  // its normal is projected onto e's orthogonal complement (plane through
+  // the neighbours' centroid), so it keeps its information across e and adds
+  // none along it (docs/lio.md "Noisy map planes"); 0 = off.
+  double tilt_projection_sigma = 3.0;
   PlaneFitOptions plane = AssociationPlaneFitDefaults();
 
   template <class V>
@@ -96,6 +103,10 @@ struct AssociationOptions {
       FieldSpec::AtLeast(1.0, "",
                          "a direction is noise-dominated when its plane information is below "
                          "this times the information normal tilt noise alone would give"));
+    v("tilt_projection_sigma", tilt_projection_sigma,
+      FieldSpec::AtLeast(0.0, "",
+                         "along noise-dominated directions project out normals leaning toward "
+                         "them by less than this many modelled tilt stddevs; 0 = off"));
     v("degeneracy_threshold", degeneracy_threshold,
       FieldSpec::AtLeast(0.0, "", "degenerate scan: smallest eigenvalue of sum n n^T below this"));
     v("plane", plane);
@@ -109,6 +120,7 @@ struct AssociationStats {
   int num_no_plane = 0;       // too few / too far neighbours, not planar
   int num_gated = 0;          // plane found, residual too large
   int num_tilt_gated = 0;     // dropped along a noise-dominated direction
+  int num_tilt_projected = 0; // normal projected off a noise-dominated direction
   int num_correspondences = 0;
   /// sum_n n_n n_n^T over the correspondences: how well the planes constrain
   /// the translation in each direction (see MinNormalInformation()).
