@@ -74,12 +74,13 @@ struct AssociationOptions {
   // set {indoor_3uav seed 1, corridor seed 3, exploration seed 4}; 0 = off.
   double max_normal_stddev_rad = 0.2;
   double spurious_information_ratio = 30.0;
-  // Along such a direction e, a kept plane whose normal leans toward e by
-  // less than tilt_projection_sigma times its modelled tilt stddev toward e
-  // (|n^T e| < k TiltStddevToward(e)) cannot be told from one parallel to e:
-  // its normal is projected onto e's orthogonal complement (plane through
-  // the neighbours' centroid), so it keeps its information across e and adds
-  // none along it (docs/lio.md "Noisy map planes"); 0 = off.
+  // Along such a direction e, each kept plane's lean l = n^T e shrinks to
+  // sqrt(max(0, l^2 - (k t_e)^2)), k = tilt_projection_sigma and t_e =
+  // Plane::TiltStddevToward(e): a plane parallel to e within k sigma is
+  // projected onto e's complement, a real lean keeps what noise cannot
+  // explain; the plane then passes through its neighbours' centroid. It keeps
+  // its information across e. A normal that would lose more than half its
+  // length is dropped (docs/lio.md "Noisy map planes"); 0 = off.
   double tilt_projection_sigma = 3.0;
   PlaneFitOptions plane = AssociationPlaneFitDefaults();
 
