@@ -8,7 +8,6 @@
 #include <fstream>
 #include <sstream>
 #include <memory>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -66,11 +65,16 @@ void LoadScenarioWithSeed(const std::string& name, int seed, sim::Scenario* scen
   ASSERT_TRUE(file.good()) << path;
   std::stringstream text;
   text << file.rdbuf();
-  const std::string original = text.str();
-  const std::string yaml = std::regex_replace(original, std::regex("seed: [0-9]+"),
-                                              "seed: " + std::to_string(seed),
-                                              std::regex_constants::format_first_only);
-  ASSERT_NE(yaml, original) << "no `seed:` in " << path;
+  std::string yaml = text.str();
+  // The first `seed: <digits>` (no <regex>: GCC 12's -Wmaybe-uninitialized
+  // fires inside it under the sanitizer build's -Werror).
+  const std::string kKey = "seed: ";
+  const std::size_t at = yaml.find(kKey);
+  ASSERT_NE(at, std::string::npos) << "no `seed:` in " << path;
+  std::size_t end = at + kKey.size();
+  while (end < yaml.size() && yaml[end] >= '0' && yaml[end] <= '9') ++end;
+  ASSERT_GT(end, at + kKey.size()) << "no number after `seed:` in " << path;
+  yaml.replace(at, end - at, kKey + std::to_string(seed));
   const Status parsed = sim::ParseScenario(yaml, path, scenario);
   ASSERT_TRUE(parsed.ok()) << parsed.message();
   ASSERT_EQ(scenario->imperfections, sim::ImperfectionPreset::kRealistic);
