@@ -20,7 +20,6 @@ struct Cell {
   std::vector<float> observed_ranges_m;  // parallel to points_in_G (0 = unknown)
 };
 
-
 // Squared distance from `q` to the cell box [lo, lo + size) on each axis.
 inline double BoxSquaredDistance(const Eigen::Vector3d& q, const Eigen::Vector3d& lo,
                                  double size) {
@@ -125,9 +124,8 @@ bool LocalMap::Insert(const Eigen::Vector3d& point_in_G, double observed_range_m
   ++leaf.value();
   Cell& cell = m.cells[VoxelKeyOf(point_in_G, m.inv_cell)];
   cell.points_in_G.push_back(point_in_G);
-  cell.observed_ranges_m.push_back(
-      std::isfinite(observed_range_m) && observed_range_m > 0.0 ? static_cast<float>(observed_range_m)
-                                                                : 0.0f);
+  const bool known = std::isfinite(observed_range_m) && observed_range_m > 0.0;
+  cell.observed_ranges_m.push_back(known ? static_cast<float>(observed_range_m) : 0.0f);
   ++m.num_points;
   return true;
 }

@@ -59,7 +59,7 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
     out->push_back(c);
     planes_.push_back(&cached.plane);
   }
-  if (options_.max_normal_stddev_rad > 0.0) DropTiltedPlanesAlongNoiseDominatedDirections(out);
+  if (options_.max_normal_stddev_rad > 0.0) ApplyNoisyPlaneRule(out);
   for (const PlaneCorrespondence& c : *out) {
     stats_.normal_information += c.normal_in_G * c.normal_in_G.transpose();
   }
@@ -67,8 +67,7 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
   return Status::Ok();
 }
 
-void ScanAssociator::DropTiltedPlanesAlongNoiseDominatedDirections(
-    std::vector<PlaneCorrespondence>* out) {
+void ScanAssociator::ApplyNoisyPlaneRule(std::vector<PlaneCorrespondence>* out) {
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d spurious = Eigen::Matrix3d::Zero();
   for (size_t i = 0; i < out->size(); ++i) {

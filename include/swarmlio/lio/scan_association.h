@@ -153,9 +153,11 @@ class ScanAssociator {
     Plane plane;
   };
 
-  // Applies max_normal_stddev_rad (see AssociationOptions) to `out`, whose
-  // planes are planes_; counts the dropped ones.
-  void DropTiltedPlanesAlongNoiseDominatedDirections(std::vector<PlaneCorrespondence>* out);
+  // The noisy-plane rule (AssociationOptions: max_normal_stddev_rad, then
+  // tilt_projection_sigma) on `out`, whose planes are planes_: drops and
+  // shrinks along noise-dominated directions and counts both. Runs only while
+  // max_normal_stddev_rad > 0 (which so switches the whole rule off).
+  void ApplyNoisyPlaneRule(std::vector<PlaneCorrespondence>* out);
 
   const LocalMap* map_;
   AssociationOptions options_;
