@@ -243,33 +243,51 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat,
 
 EsikfUpdateResult EsikfUpdate::Run(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
                                    const std::vector<MeasurementModel*>& models,
-                                   const std::vector<int>* estimated_teammates) const {
-  return RunFrom(x_hat, P_hat, x_hat, models, estimated_teammates);
+                                   const std::vector<int>* estimated_teammates,
+                                   const std::vector<int>* considered_teammates) const {
+  return RunFrom(x_hat, P_hat, x_hat, models, estimated_teammates, considered_teammates);
 }
 
 EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
                                        const SwarmState& x_start,
                                        const std::vector<MeasurementModel*>& models,
-                                       const std::vector<int>* estimated_teammates) const {
-  if (estimated_teammates == nullptr ||
-      *estimated_teammates == x_hat.layout().teammate_ids()) {
+                                       const std::vector<int>* estimated_teammates,
+                                       const std::vector<int>* considered_teammates) const {
+  const bool none_considered = considered_teammates == nullptr || considered_teammates->empty();
+  if (none_considered && (estimated_teammates == nullptr ||
+                          *estimated_teammates == x_hat.layout().teammate_ids())) {
     return RunAll(x_hat, P_hat, x_start, models);
   }
   EsikfUpdateResult result;
   result.state = x_hat;
   result.covariance = P_hat;
   const ErrorStateLayout& layout = x_hat.layout();
-  // Estimated teammates in layout order; every id must be present.
+  const auto listed = [](const std::vector<int>* list, int id) {
+    return list != nullptr && std::find(list->begin(), list->end(), id) != list->end();
+  };
+  // The blocks in the solve (estimated and considered) in layout order; every
+  // listed id must be present, once, and in one list only.
   std::vector<int> ids;
+  std::vector<int> considered;
+  size_t num_estimated = 0;
   for (int id : layout.teammate_ids()) {
-    if (std::find(estimated_teammates->begin(), estimated_teammates->end(), id) !=
-        estimated_teammates->end()) {
-      ids.push_back(id);
+    const bool is_considered = listed(considered_teammates, id);
+    const bool is_estimated =
+        estimated_teammates == nullptr ? !is_considered : listed(estimated_teammates, id);
+    if (is_considered && is_estimated) {
+      result.status = Status::InvalidArgument("EsikfUpdate: teammate " + std::to_string(id) +
+                                              " is both estimated and considered");
+      return result;
     }
+    if (is_considered) considered.push_back(id);
+    if (is_estimated) ++num_estimated;
+    if (is_considered || is_estimated) ids.push_back(id);
   }
-  if (ids.size() != estimated_teammates->size()) {
+  if ((estimated_teammates != nullptr && num_estimated != estimated_teammates->size()) ||
+      (considered_teammates != nullptr && considered.size() != considered_teammates->size())) {
     result.status = Status::InvalidArgument(
-        "EsikfUpdate: estimated_teammates names a teammate absent from the state (or twice)");
+        "EsikfUpdate: estimated_teammates or considered_teammates names a teammate absent from "
+        "the state (or twice)");
     return result;
   }
   if (P_hat.rows() != x_hat.Dim() || P_hat.cols() != x_hat.Dim() ||
@@ -320,6 +338,25 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::Mat
   for (size_t r = 0; r < o_idx.size(); ++r) {
     for (size_t c = 0; c < s_idx.size(); ++c) {
       P(o_idx[r], s_idx[c]) = P(s_idx[c], o_idx[r]) = P_os_plus(r, c);
+    }
+  }
+  // Considered blocks: the joint step gives the estimated blocks the
+  // Schmidt-Kalman gain and cross-covariance (its gain rows for them are
+  // (P_ss H_s^T + P_sc H_c^T) S^-1); the considered ones are not corrected:
+  // their mean and their covariance with every block not estimated are
+  // restored.
+  if (!considered.empty()) {
+    std::vector<int> not_estimated = o_idx;
+    for (int id : considered) {
+      result.state.teammate(id) = x_hat.teammate(id);
+      const Segment b = layout.TeammateBlock(id);
+      for (int k = b.offset; k < b.end(); ++k) not_estimated.push_back(k);
+    }
+    for (int id : considered) {
+      const Segment b = layout.TeammateBlock(id);
+      for (int r = b.offset; r < b.end(); ++r) {
+        for (int k : not_estimated) P(r, k) = P(k, r) = P_hat(r, k);
+      }
     }
   }
   result.covariance_time_s += SecondsSince(t_cov);

@@ -391,10 +391,10 @@ void Odometry::UpdateWithFilter(const UpdateRequest& request, SwarmState* x_io,
         });
     std::vector<MeasurementModel*> models{&planes};
     models.insert(models.end(), request.models.begin(), request.models.end());
+    const bool subset = hooks_ != nullptr && !im.probe.active;
     const EsikfUpdateResult result =
-        im.update.Run(x, P, models,
-                      hooks_ != nullptr && !im.probe.active ? &request.estimated_teammates
-                                                            : nullptr);
+        im.update.Run(x, P, models, subset ? &request.estimated_teammates : nullptr,
+                      subset ? &request.considered_teammates : nullptr);
     out->timings.association_s = result.association_time_s;
     out->timings.solve_s = result.solve_time_s;
     out->timings.covariance_s = result.covariance_time_s;
@@ -448,6 +448,7 @@ void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
   input.use_planes = enough_points;
   input.excluded = request.excluded;
   input.models = request.models;
+  input.considered_teammates = request.considered_teammates;
   std::vector<internal::LeavingScan> leaving;
   std::string model_error;
   const Status added = im.window->AddState(std::move(input), &leaving, &out->timings.marginalize_s,

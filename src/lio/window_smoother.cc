@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "factors/constant_block_cost.h"
 #include "window_state.h"
 
 namespace swarmlio::lio::internal {
@@ -198,6 +199,16 @@ Status WindowSmoother::Impl::TakeObservations(WindowStateInput* input, WindowSca
         status = Status::InvalidArgument(std::string("window: a residual block of ") +
                                          model->name() + " does not match its state blocks");
         continue;
+      }
+      // Considered teammates: held at the prediction in this scan's terms.
+      for (int id : input->considered_teammates) {
+        const auto at = std::find(term.blocks.begin(), term.blocks.end(), id);
+        if (at == term.blocks.end() || !input->x_pred.HasTeammate(id)) continue;
+        std::vector<double> value(GlobalExtrinsic::kAmbientSize);
+        input->x_pred.teammate(id).ToParameters(value.data());
+        term.cost = std::make_unique<ConstantBlockCost>(
+            std::move(term.cost), static_cast<int>(at - term.blocks.begin()), std::move(value));
+        term.blocks.erase(at);
       }
       scan->observations.push_back(std::move(term));
     }

@@ -59,6 +59,9 @@ struct WindowStateInput {
   /// The hooks' models of this scan: their terms are taken over
   /// (MeasurementModel::ReleaseTerms) and stay with the scan's state.
   std::vector<MeasurementModel*> models;
+  /// Teammates the filter would consider (UpdateRequest): the window holds
+  /// them at x_pred in this scan's terms (docs/window.md).
+  std::vector<int> considered_teammates;
 };
 
 struct WindowSolveResult {

@@ -15,6 +15,7 @@
 #include <variant>
 
 #include "factors/active_observation_factor.h"
+#include "factors/constant_block_cost.h"
 #include "factors/gravity_alignment_factor.h"
 #include "factors/passive_observation_factor.h"
 #include "drone_estimator_impl.h"
@@ -28,7 +29,6 @@ using internal::CanRelay;
 using internal::ChainPassesThrough;
 using internal::ComposeExtrinsic;
 using internal::SetProvenance;
-using internal::FixedExtrinsicCost;
 using internal::HeardTeammates;
 using internal::ObservationShare;
 using internal::Predict;
@@ -321,10 +321,14 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
   im.dead_reckoning.Append(*scan.poses, so.max_message_age_s + 0.5);
 
   // 4. Observation factors.
-  const bool frozen = so.degeneracy_policy == DegeneracyPolicy::kFreezeExtrinsics &&
+  // After a degenerate scan the observed extrinsics are not corrected
+  // (degeneracy_policy): considered (their covariance in the gain) or exact.
+  const bool frozen = so.degeneracy_policy != DegeneracyPolicy::kEstimateAll &&
                       scan.previous_scan_degenerate;
+  const bool exact = so.degeneracy_policy == DegeneracyPolicy::kFreezeExtrinsics;
   im.part.frozen = frozen && x->layout().NumTeammates() > 0;
   std::set<int> estimated;
+  std::set<int> considered;  // frozen: in the update with their covariance, not corrected
   // A well-localized drone does not take a degenerate teammate's pose into
   // its own state; a degenerate one still does (it is its best information).
   // Only a drone that is degenerate most of the time (an exponential average
@@ -344,13 +348,15 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
       ++counters_.observations_rejected;
       return false;
     }
-    if (frozen) {
-      im.model.Add(std::make_unique<FixedExtrinsicCost>(std::move(cost), x->teammate(teammate_id)),
+    if (frozen && exact) {
+      std::vector<double> T(GlobalExtrinsic::kAmbientSize);
+      x->teammate(teammate_id).ToParameters(T.data());
+      im.model.Add(std::make_unique<ConstantBlockCost>(std::move(cost), 1, std::move(T)),
                    {kEgoBlock});
-    } else {
-      im.model.Add(std::move(cost), {kEgoBlock, teammate_id});
-      estimated.insert(teammate_id);
+      return true;
     }
+    im.model.Add(std::move(cost), {kEgoBlock, teammate_id});
+    (frozen ? considered : estimated).insert(teammate_id);
     return true;
   };
   const Eigen::Matrix3d R_Gi_bi = x->ego.R_G_b();
@@ -449,6 +455,7 @@ Status DroneEstimator::OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, 
 
   if (!im.model.empty()) request->models.push_back(&im.model);
   request->estimated_teammates.assign(estimated.begin(), estimated.end());
+  request->considered_teammates.assign(considered.begin(), considered.end());
   // 5. Tracked objects stay out of the map.
   const Eigen::Isometry3d T_bi_Gi = T_Gi_bi.inverse();
   for (const teammate::TrackerState& s : im.detection.trackers) {

@@ -1,6 +1,6 @@
 // The mutual-observation residual terms of one scan (swarm::DroneEstimator,
 // docs/swarm.md section 4): the model the update re-evaluates at every
-// iteration, the constant-extrinsic wrapper of the degeneracy policy, and the
+// iteration, the share of an observation's information, and the
 // covariance hygiene every input from the network goes through. Internal to
 // src/swarm.
 #pragma once
@@ -9,7 +9,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
-#include <array>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -19,28 +18,6 @@
 #include "swarmlio/swarm/swarm_options.h"
 
 namespace swarmlio::swarm::internal {
-
-// A two-block observation cost (ego, extrinsic) with the extrinsic held
-// constant: the degeneracy policy "freeze extrinsics" (docs/swarm.md).
-class FixedExtrinsicCost final : public ceres::CostFunction {
- public:
-  FixedExtrinsicCost(std::unique_ptr<ceres::CostFunction> inner, const GlobalExtrinsic& T)
-      : inner_(std::move(inner)) {
-    T.ToParameters(extrinsic_.data());
-    set_num_residuals(inner_->num_residuals());
-    mutable_parameter_block_sizes()->push_back(EgoState::kAmbientSize);
-  }
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const double* blocks[2] = {parameters[0], extrinsic_.data()};
-    double* inner_jacobians[2] = {jacobians != nullptr ? jacobians[0] : nullptr, nullptr};
-    return inner_->Evaluate(blocks, residuals, jacobians != nullptr ? inner_jacobians : nullptr);
-  }
-
- private:
-  std::unique_ptr<ceres::CostFunction> inner_;
-  std::array<double, GlobalExtrinsic::kAmbientSize> extrinsic_{};
-};
 
 // The mutual observations of one scan: factors built at the front end; the
 // update re-evaluates them at every iteration (their residuals are exact

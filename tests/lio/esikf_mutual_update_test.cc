@@ -4,10 +4,13 @@
 // observation rows written out here from the paper's equations
 // (independently of the factors' code), covariance included; an update that
 // estimates only some teammate blocks equals the Schmidt-Kalman update
-// (zero gain for the blocks left out, Joseph-form covariance).
+// (zero gain for the blocks left out, Joseph-form covariance), also with
+// considered blocks in the gain.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
+#include <string>
 
 #include "esikf_test_util.h"
 #include "factors/active_observation_factor.h"
@@ -279,6 +282,105 @@ TEST(EsikfMutualUpdate, SubsetUpdateIsTheSchmidtKalmanUpdate) {
   const Segment b2 = pr.x_hat.layout().TeammateBlock(2);
   EXPECT_GT(MaxAbs(result.covariance.block(0, b2.offset, 18, 6) - pr.P.block(0, b2.offset, 18, 6)),
             1e-6);
+}
+
+// Teammates 7 and 12 observed; 7 estimated, 12 considered (the degeneracy
+// policy "freeze extrinsics"), 2 left out. The Schmidt-Kalman update with the
+// full observation rows: gain K_s = P_J[s,:] H^T (H P_J H^T + I)^-1 for the
+// ego and block 7, zero elsewhere, Joseph-form covariance. Block 12's
+// covariance enters the gain; its mean, its marginal covariance and its
+// cross-covariance with block 2 stay.
+TEST(EsikfMutualUpdate, ConsideredBlocksEnterTheGainAndStayUncorrected) {
+  Problem pr;
+  MakeProblem(14, true, {7, 12}, &pr);
+  const std::vector<PlaneCorrespondence> planes = pr.planes;
+  PlaneMeasurementModel plane_model([&planes](const SwarmState&, std::vector<PlaneCorrespondence>* out) {
+    *out = planes;
+    return Status::Ok();
+  });
+  const std::vector<int> estimated = {7};
+  const std::vector<int> considered = {12};
+  const EsikfUpdateResult result =
+      OneStep().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &estimated, &considered);
+  ASSERT_TRUE(result.status.ok()) << result.status.message();
+  // The step moves block 12 inside the solve; the covariance rows are taken
+  // at that joint solution (as the IEKF reports its covariance).
+  const std::vector<int> both = {7, 12};
+  const EsikfUpdateResult joint =
+      OneStep().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &both);
+  ASSERT_TRUE(joint.status.ok());
+
+  const int n = pr.x_hat.Dim();
+  const ErrorStateLayout& layout = pr.x_hat.layout();
+  std::vector<int> kept;
+  for (int k = 0; k < 18; ++k) kept.push_back(k);
+  for (int k = 0; k < 6; ++k) kept.push_back(layout.TeammateBlock(7).offset + k);
+  const auto schmidt = [&](const SwarmState& at, Eigen::VectorXd* dx, Eigen::MatrixXd* P_plus) {
+    Eigen::MatrixXd H;
+    Eigen::VectorXd z;
+    AllRows(pr, at, &H, &z);
+    const Eigen::VectorXd e = at.BoxMinus(pr.x_hat);
+    Eigen::MatrixXd J_inv = Eigen::MatrixXd::Identity(n, n);
+    J_inv.block<3, 3>(0, 0) = so3::RightJacobian(e.head<3>());
+    for (int id : layout.teammate_ids()) {
+      const int o = layout.TeammateRotation(id).offset;
+      J_inv.block<3, 3>(o, o) = so3::RightJacobian(e.segment<3>(o));
+    }
+    const Eigen::MatrixXd P_J = J_inv * pr.P * J_inv.transpose();
+    const Eigen::MatrixXd S = H * P_J * H.transpose() + Eigen::MatrixXd::Identity(H.rows(), H.rows());
+    const Eigen::MatrixXd K_all = P_J * H.transpose() * S.inverse();
+    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n, H.rows());
+    for (int r : kept) K.row(r) = K_all.row(r);
+    const Eigen::MatrixXd I_KH = Eigen::MatrixXd::Identity(n, n) - K * H;
+    *P_plus = I_KH * P_J * I_KH.transpose() + K * K.transpose();
+    *dx = -K * z;
+  };
+  Eigen::VectorXd dx, unused_dx;
+  Eigen::MatrixXd unused_P, P_plus;
+  schmidt(pr.x_hat, &dx, &unused_P);
+  schmidt(joint.state, &unused_dx, &P_plus);
+  const double dx_err = MaxAbs(result.state.BoxMinus(pr.x_hat) - dx);
+  EXPECT_LT(dx_err, 1e-9);
+  // Rows of the ego state and block 7 against every block.
+  double P_err = 0.0;
+  for (int r : kept) P_err = std::max(P_err, MaxAbs(result.covariance.row(r) - P_plus.row(r)));
+  EXPECT_LT(P_err, 1e-9);
+  RecordProperty("max_abs_dx_diff", std::to_string(dx_err));
+  RecordProperty("max_abs_P_diff", std::to_string(P_err));
+  // Block 12: mean, marginal covariance, cross-covariance with block 2 kept.
+  const Segment b12 = layout.TeammateBlock(12);
+  const Segment b2 = layout.TeammateBlock(2);
+  EXPECT_EQ(result.state.teammate(12).p_Gj_in_Gi, pr.x_hat.teammate(12).p_Gj_in_Gi);
+  EXPECT_EQ(result.state.teammate(12).q_Gi_Gj.coeffs(), pr.x_hat.teammate(12).q_Gi_Gj.coeffs());
+  EXPECT_EQ(MaxAbs(result.covariance.block(b12.offset, b12.offset, 6, 6) -
+                   pr.P.block(b12.offset, b12.offset, 6, 6)),
+            0.0);
+  EXPECT_EQ(MaxAbs(result.covariance.block(b12.offset, b2.offset, 6, 6) -
+                   pr.P.block(b12.offset, b2.offset, 6, 6)),
+            0.0);
+  // The considered block mattered: leaving its covariance out (block 12
+  // held exact, the former "frozen" form) gives another ego step.
+  EXPECT_GT(dx.head<6>().norm(), 1e-3);
+  Eigen::MatrixXd P_exact = pr.P;
+  P_exact.block(b12.offset, 0, 6, n).setZero();
+  P_exact.block(0, b12.offset, n, 6).setZero();
+  P_exact.block(b12.offset, b12.offset, 6, 6) = 1e-12 * Eigen::Matrix<double, 6, 6>::Identity();
+  const EsikfUpdateResult exact =
+      OneStep().Run(pr.x_hat, P_exact, {&plane_model, &pr.terms}, &estimated, &considered);
+  ASSERT_TRUE(exact.status.ok());
+  EXPECT_GT((exact.state.BoxMinus(pr.x_hat) - dx).head<6>().norm(), 1e-4);
+}
+
+TEST(EsikfMutualUpdate, ABlockBothEstimatedAndConsideredIsAnError) {
+  Problem pr;
+  MakeProblem(15, true, {7}, &pr);
+  const std::vector<int> estimated = {7};
+  const std::vector<int> considered = {7};
+  EXPECT_EQ(OneStep().Run(pr.x_hat, pr.P, {&pr.terms}, &estimated, &considered).status.code(),
+            Status::Code::kInvalidArgument);
+  const std::vector<int> absent = {5};
+  EXPECT_EQ(OneStep().Run(pr.x_hat, pr.P, {&pr.terms}, &estimated, &absent).status.code(),
+            Status::Code::kInvalidArgument);
 }
 
 TEST(EsikfMutualUpdate, ResidualBlockNamingAnAbsentTeammateIsAnError) {

@@ -103,9 +103,14 @@ void ExtrinsicDifference(const DroneRun& a, const DroneRun& b, double* max_m, do
 // teammate blocks random-walking over each interval as in the filter. What
 // differs: the filter estimates only the teammate blocks observed in a scan
 // (the others are Schmidt "consider" states, docs/esikf.md), the window
-// estimates all of them; the drones' broadcasts then differ slightly, so the
-// differences compound through the messages. Measured: 1.1 mm (uav3), 0.02
-// mm (uav1, uav2); with the filter estimating every teammate block (a
+// estimates all of them; after a degenerate scan the filter takes the
+// observed blocks into its gain as considered states (their covariance in
+// the innovation, not corrected), the window holds them at the prediction
+// (docs/window.md). The drones' broadcasts then differ slightly, so the
+// differences compound through the messages. Measured: 3.0 mm / 0.14 deg
+// (uav3, the Avia with degenerate scans), 0.08 and 0.03 mm / 0.09 and 0.11
+// deg (uav1, uav2); 1.1 mm for uav3 while the filter also held them exact;
+// with the filter estimating every teammate block and holding them exact (a
 // throwaway change) the runs agreed to 4.4e-7 m and 5.5e-7 m in T_Gi_Gj.
 // K = 5: both teammates identified and fused, accuracy within the filter's.
 // (One test: the simulation and the filter's run are shared.)
@@ -132,9 +137,9 @@ TEST_F(WindowSwarmTest, WindowFusesTheTeammatesAndEqualsTheFilterAtOneState) {
                 filter[i].fused);
     EXPECT_EQ(one[i].identified, 2);
     EXPECT_GT(one[i].fused, 100);
-    EXPECT_LT(max_dp, 2e-3);
+    EXPECT_LT(max_dp, 5e-3);
     EXPECT_LT(max_dT_m, 5e-3);
-    EXPECT_LT(max_dT_deg, 0.1);
+    EXPECT_LT(max_dT_deg, 0.2);
 
     ExtrinsicDifference(filter[i], five[i], &max_dT_m, &max_dT_deg);
     std::printf("[ figures  ] %s: K = 5: position RMSE %.4f m (filter %.4f m), extrinsics vs "

@@ -21,6 +21,14 @@
 // estimated blocks becomes P_os P_ss^-1 P_ss^+ (the Schmidt-Kalman
 // "consider" update: exact covariance of an estimator that does not correct
 // them), so the cost grows with the teammates observed, not with the swarm.
+//
+// Considered teammates (the degeneracy policy "freeze extrinsics",
+// docs/esikf.md "Considered blocks"): blocks the residuals name but the
+// update does not correct. They enter the solve with their covariance, so
+// their uncertainty reaches the innovation and the gain of the estimated
+// blocks (K_s = (P_ss H_s^T + P_sc H_c^T) S^-1); then their mean, their
+// marginal covariance and their cross-covariance with every block not
+// estimated are restored (Schmidt-Kalman).
 #pragma once
 
 #include <ceres/solver.h>
@@ -114,15 +122,21 @@ class EsikfUpdate {
   /// re-linearized at every iteration. `estimated_teammates`: the teammate
   /// ids whose blocks this update estimates (nullptr: all in x_hat's layout;
   /// ids absent from the layout are an error); see the file comment.
+  /// `considered_teammates`: ids (in the layout, none also estimated) whose
+  /// blocks the residuals may name but the update does not correct (file
+  /// comment). With estimated_teammates nullptr, every teammate not
+  /// considered is estimated.
   EsikfUpdateResult Run(const SwarmState& x_hat,
                         const Eigen::MatrixXd& P_hat,
                         const std::vector<MeasurementModel*>& models,
-                        const std::vector<int>* estimated_teammates = nullptr) const;
+                        const std::vector<int>* estimated_teammates = nullptr,
+                        const std::vector<int>* considered_teammates = nullptr) const;
   EsikfUpdateResult RunFrom(const SwarmState& x_hat,
                             const Eigen::MatrixXd& P_hat,
                             const SwarmState& x_start,
                             const std::vector<MeasurementModel*>& models,
-                            const std::vector<int>* estimated_teammates = nullptr) const;
+                            const std::vector<int>* estimated_teammates = nullptr,
+                            const std::vector<int>* considered_teammates = nullptr) const;
 
   const EsikfUpdateOptions& options() const { return options_; }
 

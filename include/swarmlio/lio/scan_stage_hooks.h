@@ -50,6 +50,9 @@ struct UpdateRequest {
   std::vector<MeasurementModel*> models;  // owned by the hook, valid until OnUpdated
   /// Teammate blocks the update estimates (the others: Schmidt "consider").
   std::vector<int> estimated_teammates;
+  /// Teammate blocks the models' residuals name that the update does not
+  /// correct (EsikfUpdate::Run, "considered teammates").
+  std::vector<int> considered_teammates;
   std::vector<ExcludedRegion> excluded;
 };
 

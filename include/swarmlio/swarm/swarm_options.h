@@ -16,9 +16,11 @@ namespace swarmlio::swarm {
 /// What the update does with the extrinsic blocks when the last scan was
 /// LiDAR-degenerate (docs/swarm.md "Degeneracy").
 enum class DegeneracyPolicy {
-  kFreezeExtrinsics,  // Swarm-LIO2: hold T_Gi_Gj, trust the teammates (the observations
-                      // constrain the ego state only)
-  kEstimateAll,       // keep estimating T_Gi_Gj
+  kConsiderExtrinsics,  // do not correct T_Gi_Gj, but its covariance enters the gain
+                        // (Schmidt-Kalman consider states; docs/esikf.md)
+  kFreezeExtrinsics,    // Swarm-LIO2: hold T_Gi_Gj as exact constants, trust the teammates
+                        // (the observations constrain the ego state only)
+  kEstimateAll,         // keep estimating T_Gi_Gj
 };
 
 /// Which observations a drone sends again in its next state message, for
@@ -36,7 +38,8 @@ enum class RepeatObservations {
 namespace swarmlio::config {
 template <>
 struct EnumTraits<swarm::DegeneracyPolicy> {
-  static constexpr std::array<std::pair<swarm::DegeneracyPolicy, const char*>, 2> kNames{{
+  static constexpr std::array<std::pair<swarm::DegeneracyPolicy, const char*>, 3> kNames{{
+      {swarm::DegeneracyPolicy::kConsiderExtrinsics, "consider_extrinsics"},
       {swarm::DegeneracyPolicy::kFreezeExtrinsics, "freeze_extrinsics"},
       {swarm::DegeneracyPolicy::kEstimateAll, "estimate_all"},
   }};
@@ -100,7 +103,7 @@ struct SwarmOptions {
   /// Observations farther than this many sigma from the prediction are
   /// rejected before the update (chi-square gate on 3 dof; 0 = off).
   double gate_sigma = 5.0;
-  DegeneracyPolicy degeneracy_policy = DegeneracyPolicy::kFreezeExtrinsics;
+  DegeneracyPolicy degeneracy_policy = DegeneracyPolicy::kConsiderExtrinsics;
   /// Observations that involve a teammate whose last message says its scan
   /// was degenerate are not fused while this drone's own last scan was not
   /// degenerate (the teammate's pose is not to be trusted by a drone that
@@ -166,7 +169,8 @@ struct SwarmOptions {
       FieldSpec::Positive("rad", "smallest initial 1-sigma of R_Gi_Gj"));
     v("gate_sigma", gate_sigma, FieldSpec::AtLeast(0.0, "", "Mahalanobis gate (0 = off)"));
     v("degeneracy_policy", degeneracy_policy,
-      FieldSpec::Doc("freeze_extrinsics | estimate_all, after a degenerate scan"));
+      FieldSpec::Doc("consider_extrinsics | freeze_extrinsics | estimate_all, after a "
+                     "degenerate scan"));
     v("skip_degenerate_teammates", skip_degenerate_teammates,
       FieldSpec::Doc("do not fuse observations involving a teammate that reports degeneracy"));
     v("repeat_observations", repeat_observations,
