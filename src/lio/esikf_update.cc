@@ -302,7 +302,7 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::Mat
   }
   const Eigen::MatrixXd P_ss = Gather(P_hat, s_idx, s_idx);
   EsikfUpdateResult sub =
-      RunAll(SubsetState(x_hat, ids), P_ss, SubsetState(x_start, ids), models);
+      RunAll(SubsetState(x_hat, ids), P_ss, SubsetState(x_start, ids), models, considered);
   result.status = sub.status;
   result.iterations = sub.iterations;
   result.converged = sub.converged;
@@ -340,15 +340,13 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::Mat
       P(o_idx[r], s_idx[c]) = P(s_idx[c], o_idx[r]) = P_os_plus(r, c);
     }
   }
-  // Considered blocks: the joint step gives the estimated blocks the
-  // Schmidt-Kalman gain and cross-covariance (its gain rows for them are
-  // (P_ss H_s^T + P_sc H_c^T) S^-1); the considered ones are not corrected:
-  // their mean and their covariance with every block not estimated are
-  // restored.
+  // Considered blocks: held at x_hat in the solve (RunAll), whose joint step
+  // gives the estimated blocks the Schmidt-Kalman gain and cross-covariance
+  // (its gain rows for them are (P_ss H_s^T + P_sc H_c^T) S^-1); they are not
+  // corrected: their covariance with every block not estimated is restored.
   if (!considered.empty()) {
     std::vector<int> not_estimated = o_idx;
     for (int id : considered) {
-      result.state.teammate(id) = x_hat.teammate(id);
       const Segment b = layout.TeammateBlock(id);
       for (int k = b.offset; k < b.end(); ++k) not_estimated.push_back(k);
     }
@@ -366,7 +364,8 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::Mat
 EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
                                       const Eigen::MatrixXd& P_hat,
                                       const SwarmState& x_start,
-                                      const std::vector<MeasurementModel*>& models) const {
+                                      const std::vector<MeasurementModel*>& models,
+                                      const std::vector<int>& held) const {
   const Clock::time_point t_start = Clock::now();
   EsikfUpdateResult result;
   result.state = x_hat;
@@ -396,7 +395,12 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
   EgoStateManifold ego_manifold;
   GlobalExtrinsicManifold teammate_manifold;
   PriorFactor prior(x_hat, std::move(cholesky));
-  ParameterBlocks blocks(x_start);
+  SwarmState x = x_start;
+  const auto hold = [&x_hat, &held](SwarmState* at) {
+    for (int id : held) at->teammate(id) = x_hat.teammate(id);
+  };
+  hold(&x);
+  ParameterBlocks blocks(x);
 
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -415,7 +419,6 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
   std::vector<double*> term_pointers;
 
   const ceres::Solver::Options solver_options = GaussNewtonStepOptions(options_.linear_solver);
-  SwarmState x = x_start;
   for (int it = 0; it < options_.max_iterations; ++it) {
     // Drop last iteration's measurement blocks, re-linearize every model at x.
     for (ceres::ResidualBlockId id : measurement_blocks) problem.RemoveResidualBlock(id);
@@ -465,7 +468,11 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
     result.num_rejected_steps += summary.num_unsuccessful_steps;
     ++result.iterations;
 
-    const SwarmState x_next = blocks.Read(x);
+    SwarmState x_next = blocks.Read(x);
+    if (!held.empty()) {
+      hold(&x_next);
+      blocks.Write(x_next);
+    }
     const Eigen::VectorXd dx = x_next.BoxMinus(x);
     x = x_next;
     if (summary.num_unsuccessful_steps > 0) break;  // Ceres refused the GN step

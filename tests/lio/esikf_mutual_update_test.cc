@@ -303,12 +303,15 @@ TEST(EsikfMutualUpdate, ConsideredBlocksEnterTheGainAndStayUncorrected) {
   const EsikfUpdateResult result =
       OneStep().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &estimated, &considered);
   ASSERT_TRUE(result.status.ok()) << result.status.message();
-  // The step moves block 12 inside the solve; the covariance rows are taken
-  // at that joint solution (as the IEKF reports its covariance).
+  // Letting block 12 move in the solve (estimating it) moves the ego state
+  // differently from the considered update (the rows of the next iteration
+  // would be linearized there), so the comparison below can tell.
   const std::vector<int> both = {7, 12};
   const EsikfUpdateResult joint =
-      OneStep().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &both);
+      EsikfUpdate().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &both);
   ASSERT_TRUE(joint.status.ok());
+  EXPECT_GT((joint.state.teammate(12).p_Gj_in_Gi - pr.x_hat.teammate(12).p_Gj_in_Gi).norm(),
+            1e-3);
 
   const int n = pr.x_hat.Dim();
   const ErrorStateLayout& layout = pr.x_hat.layout();
@@ -338,7 +341,7 @@ TEST(EsikfMutualUpdate, ConsideredBlocksEnterTheGainAndStayUncorrected) {
   Eigen::VectorXd dx, unused_dx;
   Eigen::MatrixXd unused_P, P_plus;
   schmidt(pr.x_hat, &dx, &unused_P);
-  schmidt(joint.state, &unused_dx, &P_plus);
+  schmidt(result.state, &unused_dx, &P_plus);
   const double dx_err = MaxAbs(result.state.BoxMinus(pr.x_hat) - dx);
   EXPECT_LT(dx_err, 1e-9);
   // Rows of the ego state and block 7 against every block.
@@ -358,6 +361,13 @@ TEST(EsikfMutualUpdate, ConsideredBlocksEnterTheGainAndStayUncorrected) {
   EXPECT_EQ(MaxAbs(result.covariance.block(b12.offset, b2.offset, 6, 6) -
                    pr.P.block(b12.offset, b2.offset, 6, 6)),
             0.0);
+  // Iterated: block 12 stays at its prior mean through every iteration.
+  const EsikfUpdateResult iterated =
+      EsikfUpdate().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &estimated, &considered);
+  ASSERT_TRUE(iterated.status.ok());
+  EXPECT_GT(iterated.iterations, 1);
+  EXPECT_EQ(iterated.state.teammate(12).p_Gj_in_Gi, pr.x_hat.teammate(12).p_Gj_in_Gi);
+  EXPECT_EQ(iterated.state.teammate(12).q_Gi_Gj.coeffs(), pr.x_hat.teammate(12).q_Gi_Gj.coeffs());
   // The considered block mattered: leaving its covariance out (block 12
   // held exact, the former "frozen" form) gives another ego step.
   EXPECT_GT(dx.head<6>().norm(), 1e-3);

@@ -26,9 +26,10 @@
 // docs/esikf.md "Considered blocks"): blocks the residuals name but the
 // update does not correct. They enter the solve with their covariance, so
 // their uncertainty reaches the innovation and the gain of the estimated
-// blocks (K_s = (P_ss H_s^T + P_sc H_c^T) S^-1); then their mean, their
-// marginal covariance and their cross-covariance with every block not
-// estimated are restored (Schmidt-Kalman).
+// blocks (K_s = (P_ss H_s^T + P_sc H_c^T) S^-1), but every iteration's step
+// for them is discarded (the residuals are linearized at their prior mean);
+// then their marginal covariance and their cross-covariance with every block
+// not estimated are restored (iterated Schmidt-Kalman).
 #pragma once
 
 #include <ceres/solver.h>
@@ -141,10 +142,14 @@ class EsikfUpdate {
   const EsikfUpdateOptions& options() const { return options_; }
 
  private:
-  // All blocks of x_hat estimated.
+  // All blocks of x_hat in the solve; the teammates in `held` (considered)
+  // stay at x_hat: every iteration's step for them is discarded, so the
+  // residuals are linearized there and the others get the iterated
+  // Schmidt-Kalman step.
   EsikfUpdateResult RunAll(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
                            const SwarmState& x_start,
-                           const std::vector<MeasurementModel*>& models) const;
+                           const std::vector<MeasurementModel*>& models,
+                           const std::vector<int>& held = {}) const;
   EsikfUpdateOptions options_;
 };
 
