@@ -22,7 +22,7 @@
 // "consider" update: exact covariance of an estimator that does not correct
 // them), so the cost grows with the teammates observed, not with the swarm.
 //
-// Considered teammates (the degeneracy policy "freeze extrinsics",
+// Considered teammates (the degeneracy policy consider_extrinsics,
 // docs/esikf.md "Considered blocks"): blocks the residuals name but the
 // update does not correct. They enter the solve with their covariance, so
 // their uncertainty reaches the innovation and the gain of the estimated
