@@ -174,6 +174,32 @@ EsikfUpdate OneStep() {
   return EsikfUpdate(o);
 }
 
+// The Schmidt-Kalman step with the full observation rows at `at`: gain
+// K = P_J[kept,:] H^T (H P_J H^T + I)^-1 on the rows `kept`, zero elsewhere,
+// P_J the prior in the tangent at `at` (J^-1 P J^-T), Joseph-form covariance.
+void SchmidtStep(const Problem& pr, const SwarmState& at, const std::vector<int>& kept,
+                 Eigen::VectorXd* dx, Eigen::MatrixXd* P_plus) {
+  const int n = pr.x_hat.Dim();
+  Eigen::MatrixXd H;
+  Eigen::VectorXd z;
+  AllRows(pr, at, &H, &z);
+  const Eigen::VectorXd e = at.BoxMinus(pr.x_hat);
+  Eigen::MatrixXd J_inv = Eigen::MatrixXd::Identity(n, n);
+  J_inv.block<3, 3>(0, 0) = so3::RightJacobian(e.head<3>());
+  for (int id : pr.x_hat.layout().teammate_ids()) {
+    const int o = pr.x_hat.layout().TeammateRotation(id).offset;
+    J_inv.block<3, 3>(o, o) = so3::RightJacobian(e.segment<3>(o));
+  }
+  const Eigen::MatrixXd P_J = J_inv * pr.P * J_inv.transpose();
+  const Eigen::MatrixXd S = H * P_J * H.transpose() + Eigen::MatrixXd::Identity(H.rows(), H.rows());
+  const Eigen::MatrixXd K_all = P_J * H.transpose() * S.inverse();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n, H.rows());
+  for (int r : kept) K.row(r) = K_all.row(r);
+  const Eigen::MatrixXd I_KH = Eigen::MatrixXd::Identity(n, n) - K * H;
+  *P_plus = I_KH * P_J * I_KH.transpose() + K * K.transpose();
+  *dx = -K * z;
+}
+
 TEST(EsikfMutualUpdate, OneStepEqualsTheIteratedKalmanStepWithBothObservationTypes) {
   Problem pr;
   MakeProblem(11, false, {2, 7}, &pr);
@@ -231,41 +257,13 @@ TEST(EsikfMutualUpdate, SubsetUpdateIsTheSchmidtKalmanUpdate) {
   // Full-state rows, gain zeroed for the blocks left out, Joseph form. The
   // step from the rows at x_hat; the covariance from the rows and the prior
   // correction J at the solution (as the IEKF reports it, see the first test).
-  const int n = pr.x_hat.Dim();
   std::vector<int> kept;
   for (int k = 0; k < 18; ++k) kept.push_back(k);
   for (int k = 0; k < 6; ++k) kept.push_back(pr.x_hat.layout().TeammateBlock(7).offset + k);
-  const auto schmidt = [&](const SwarmState& at, Eigen::VectorXd* dx, Eigen::MatrixXd* P_plus) {
-    Eigen::MatrixXd H;
-    Eigen::VectorXd z;
-    AllRows(pr, at, &H, &z);
-    const Eigen::VectorXd e = at.BoxMinus(pr.x_hat);
-    Eigen::MatrixXd J_inv = Eigen::MatrixXd::Identity(n, n);
-    J_inv.block<3, 3>(0, 0) = so3::RightJacobian(e.head<3>());
-    for (int id : pr.x_hat.layout().teammate_ids()) {
-      const int o = pr.x_hat.layout().TeammateRotation(id).offset;
-      J_inv.block<3, 3>(o, o) = so3::RightJacobian(e.segment<3>(o));
-    }
-    const Eigen::MatrixXd P_J = J_inv * pr.P * J_inv.transpose();
-    Eigen::MatrixXd Hs(H.rows(), kept.size());
-    Eigen::MatrixXd Pss(kept.size(), kept.size());
-    for (size_t c = 0; c < kept.size(); ++c) {
-      Hs.col(c) = H.col(kept[c]);
-      for (size_t r = 0; r < kept.size(); ++r) Pss(r, c) = P_J(kept[r], kept[c]);
-    }
-    const Eigen::MatrixXd S =
-        Hs * Pss * Hs.transpose() + Eigen::MatrixXd::Identity(H.rows(), H.rows());
-    const Eigen::MatrixXd Ks = Pss * Hs.transpose() * S.inverse();
-    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n, H.rows());
-    for (size_t r = 0; r < kept.size(); ++r) K.row(kept[r]) = Ks.row(r);
-    const Eigen::MatrixXd I_KH = Eigen::MatrixXd::Identity(n, n) - K * H;
-    *P_plus = I_KH * P_J * I_KH.transpose() + K * K.transpose();
-    *dx = -K * z;
-  };
   Eigen::VectorXd dx, unused_dx;
   Eigen::MatrixXd unused_P, P_plus;
-  schmidt(pr.x_hat, &dx, &unused_P);
-  schmidt(result.state, &unused_dx, &P_plus);
+  SchmidtStep(pr, pr.x_hat, kept, &dx, &unused_P);
+  SchmidtStep(pr, result.state, kept, &unused_dx, &P_plus);
   const double dx_err = MaxAbs(result.state.BoxMinus(pr.x_hat) - dx);
   const double P_err = MaxAbs(result.covariance - P_plus);
   EXPECT_LT(dx_err, 1e-9);
@@ -318,30 +316,10 @@ TEST(EsikfMutualUpdate, ConsideredBlocksEnterTheGainAndStayUncorrected) {
   std::vector<int> kept;
   for (int k = 0; k < 18; ++k) kept.push_back(k);
   for (int k = 0; k < 6; ++k) kept.push_back(layout.TeammateBlock(7).offset + k);
-  const auto schmidt = [&](const SwarmState& at, Eigen::VectorXd* dx, Eigen::MatrixXd* P_plus) {
-    Eigen::MatrixXd H;
-    Eigen::VectorXd z;
-    AllRows(pr, at, &H, &z);
-    const Eigen::VectorXd e = at.BoxMinus(pr.x_hat);
-    Eigen::MatrixXd J_inv = Eigen::MatrixXd::Identity(n, n);
-    J_inv.block<3, 3>(0, 0) = so3::RightJacobian(e.head<3>());
-    for (int id : layout.teammate_ids()) {
-      const int o = layout.TeammateRotation(id).offset;
-      J_inv.block<3, 3>(o, o) = so3::RightJacobian(e.segment<3>(o));
-    }
-    const Eigen::MatrixXd P_J = J_inv * pr.P * J_inv.transpose();
-    const Eigen::MatrixXd S = H * P_J * H.transpose() + Eigen::MatrixXd::Identity(H.rows(), H.rows());
-    const Eigen::MatrixXd K_all = P_J * H.transpose() * S.inverse();
-    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n, H.rows());
-    for (int r : kept) K.row(r) = K_all.row(r);
-    const Eigen::MatrixXd I_KH = Eigen::MatrixXd::Identity(n, n) - K * H;
-    *P_plus = I_KH * P_J * I_KH.transpose() + K * K.transpose();
-    *dx = -K * z;
-  };
   Eigen::VectorXd dx, unused_dx;
   Eigen::MatrixXd unused_P, P_plus;
-  schmidt(pr.x_hat, &dx, &unused_P);
-  schmidt(result.state, &unused_dx, &P_plus);
+  SchmidtStep(pr, pr.x_hat, kept, &dx, &unused_P);
+  SchmidtStep(pr, result.state, kept, &unused_dx, &P_plus);
   const double dx_err = MaxAbs(result.state.BoxMinus(pr.x_hat) - dx);
   EXPECT_LT(dx_err, 1e-9);
   // Rows of the ego state and block 7 against every block.
