@@ -1,6 +1,7 @@
 #include "report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -174,8 +175,14 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
           replay::ConsistencyStats consistency;
           if (!frame.same_frame) {
             extra.push_back({"nees_position", std::string("n/a (frames differ)")});
+            extra.push_back({"nees_position_aligned", std::string("n/a (frames differ)")});
           } else if (replay::EvaluateConsistency(d.scans(), truth, 0.05, &consistency).ok()) {
             extra.push_back({"nees_position", consistency.mean_position_nees});
+            if (std::isfinite(consistency.mean_position_nees_aligned)) {
+              extra.push_back({"nees_position_aligned", consistency.mean_position_nees_aligned});
+            } else {
+              extra.push_back({"nees_position_aligned", std::string("n/a (no rotation fixed)")});
+            }
           }
         }
       }
@@ -192,7 +199,8 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
       {"time_p95_ms", "time p95 [ms]", 2},
       {"realtime_factor", "real-time factor", 1},
       {"ground_truth_frame", "ground-truth frame", 0},
-      {"nees_position", "position NEES (3 expected)", 2}};
+      {"nees_position", "position NEES in G (3 expected)", 2},
+      {"nees_position_aligned", "position NEES, SE(3) gauge aligned", 2}};
   extra_columns.push_back({"messages_received", "msgs received", 0});
   eval::MetricsTable table;
   Status status = eval::MakeDroneMetricsTable(metrics, metric_options, extra_columns, &table);

@@ -218,10 +218,12 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     }
     if (status.ok()) {
       std::printf("  %s\n", frame.Summary().c_str());
-      char nees[64];
+      char nees[128];
       if (frame.same_frame) {
-        std::snprintf(nees, sizeof(nees), "%.2f (expected %.0f)", cs.mean_position_nees,
-                      cs.expected_position_nees);
+        std::snprintf(nees, sizeof(nees),
+                      "%.2f (expected %.0f; %.2f after the gauge alignment, %.3f deg)",
+                      cs.mean_position_nees, cs.expected_position_nees,
+                      cs.mean_position_nees_aligned, cs.gauge_rotation_deg);
       } else {
         std::snprintf(nees, sizeof(nees), "n/a (frames differ)");
       }
