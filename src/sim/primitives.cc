@@ -155,6 +155,24 @@ Primitive Primitive::Transformed(const Eigen::Matrix3d& R, const Eigen::Vector3d
   return out;
 }
 
+bool Primitive::Contains(const Eigen::Vector3d& p) const {
+  switch (type_) {
+    case PrimitiveType::kBox: {
+      const Eigen::Vector3d local = R_frame_local_.transpose() * (p - center_);
+      return (local.cwiseAbs().array() < half_extents_.array()).all();
+    }
+    case PrimitiveType::kCylinder: {
+      const double radius = half_extents_.x();
+      return p.z() > center_.z() && p.z() < center_.z() + half_extents_.z() &&
+             (p.head<2>() - center_.head<2>()).squaredNorm() < radius * radius;
+    }
+    case PrimitiveType::kRectangle:
+    case PrimitiveType::kTriangle:
+      return false;
+  }
+  return false;
+}
+
 bool Primitive::Intersect(const Ray& ray, double t_min, double t_max, double* t,
                           Eigen::Vector3d* normal) const {
   switch (type_) {

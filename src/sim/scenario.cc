@@ -4,9 +4,11 @@
 // their sensors re-read over the preset after the first pass.
 #include "swarmlio/sim/scenario.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <sstream>
 
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/config/sensor_preset.h"
@@ -499,6 +501,48 @@ SimulationConfig Scenario::simulation_config() const {
 
 namespace {
 
+std::string DescribeSolid(const Primitive& p) {
+  std::ostringstream os;
+  os.precision(3);
+  const Aabb& b = p.bounds();
+  os << (p.type() == PrimitiveType::kCylinder ? "cylinder" : "box") << " spanning ["
+     << b.min.x() << ", " << b.min.y() << ", " << b.min.z() << "] to [" << b.max.x() << ", "
+     << b.max.y() << ", " << b.max.z() << "] m";
+  return os.str();
+}
+
+// A flight through a solid is physically impossible, and the simulated LiDAR
+// then sees the solid's inside faces. The body origin is sampled every
+// kFlightCheckStepS (6 cm at 3 m/s) against every closed primitive.
+constexpr double kFlightCheckStepS = 0.02;
+
+Status CheckFlightsClearScene(const config::ConfigFile& file, const Scenario& s,
+                              size_t num_listed_drones, double duration_s) {
+  const std::vector<Primitive>& solids = s.scene.primitives();
+  for (size_t i = 0; i < s.drones.size(); ++i) {
+    const Trajectory& trajectory = s.drones[i].trajectory;
+    const int steps = static_cast<int>(std::ceil(duration_s / kFlightCheckStepS));
+    for (int k = 0; k <= steps; ++k) {
+      const double t = std::min(duration_s, k * kFlightCheckStepS);
+      const Eigen::Vector3d p = trajectory.PositionAt(t);
+      for (const Primitive& solid : solids) {
+        const Aabb& b = solid.bounds();
+        if ((p.array() <= b.min.array()).any() || (p.array() >= b.max.array()).any()) continue;
+        if (!solid.Contains(p)) continue;
+        std::ostringstream os;
+        os.precision(4);
+        os << "the flight of '" << s.drones[i].name << "' passes through a " << DescribeSolid(solid)
+           << " at t = " << t << " s (body at [" << p.x() << ", " << p.y() << ", " << p.z()
+           << "] m): add a waypoint around it";
+        return file.KeyError(
+            i < num_listed_drones ? config::IndexKey("drones", i) + ".plan" : "generator",
+            os.str());
+      }
+    }
+  }
+  return Status::Ok();
+}
+
 Status BuildScenario(const config::ConfigFile& file,
                      const ScenarioOverrides& overrides,
                      Scenario* scenario) {
@@ -563,6 +607,7 @@ Status BuildScenario(const config::ConfigFile& file,
       }
     }
   }
+  SWARMLIO_RETURN_IF_ERROR(CheckFlightsClearScene(file, s, spec.drones.size(), duration_s));
   s.scene.Build();
   *scenario = std::move(s);
   return Status::Ok();

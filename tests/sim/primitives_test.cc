@@ -112,6 +112,27 @@ TEST(Primitives, TriangleInsideAndOutside) {
   EXPECT_NEAR(t, 2.0, kTol);
 }
 
+TEST(Primitives, ContainsIsTheInteriorOfClosedShapes) {
+  const Primitive box = Primitive::AxisAlignedBox({0, 0, 0}, {2, 1, 3}, kGrey);
+  EXPECT_TRUE(box.Contains({1.0, 0.5, 2.9}));
+  EXPECT_FALSE(box.Contains({1.0, 0.5, 3.1}));
+  EXPECT_FALSE(box.Contains({2.0, 0.5, 1.0}));  // on a face: not inside
+  // Rotated 45 deg about z: a corner of its bounding box is outside.
+  const Primitive turned = Primitive::OrientedBox(
+      {0, 0, 0}, so3::Exp(Eigen::Vector3d(0, 0, M_PI / 4)), {1, 1, 1}, kGrey);
+  EXPECT_TRUE(turned.Contains({1.3, 0.0, 0.5}));
+  EXPECT_FALSE(turned.Contains({1.0, 1.0, 0.0}));
+  EXPECT_TRUE(turned.bounds().min.x() < 1.0 && turned.bounds().max.y() > 1.0);
+  const Primitive pole = Primitive::VerticalCylinder({5, 5, 1}, 0.5, 2.0, kGrey);
+  EXPECT_TRUE(pole.Contains({5.3, 5.3, 2.0}));
+  EXPECT_FALSE(pole.Contains({5.4, 5.4, 2.0}));  // 0.57 m from the axis
+  EXPECT_FALSE(pole.Contains({5.0, 5.0, 0.9}));  // below the base
+  EXPECT_FALSE(pole.Contains({5.0, 5.0, 3.1}));  // above the top
+  EXPECT_FALSE(Primitive::Rectangle({0, 0, 0}, Eigen::Matrix3d::Identity(), 1, 1, kGrey)
+                   .Contains({0, 0, 0}));
+  EXPECT_FALSE(Primitive::Triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, kGrey).Contains({0.2, 0.2, 0}));
+}
+
 TEST(Primitives, TransformedMovesTheShape) {
   const Primitive box = Primitive::AxisAlignedBox({-1, -1, -1}, {1, 1, 1}, kGrey);
   const Primitive moved = box.Transformed(so3::Exp(Eigen::Vector3d(0, 0, 0.3)), {10, 0, 0});

@@ -91,6 +91,10 @@ class Primitive {
   bool Intersect(const Ray& ray, double t_min, double t_max, double* t,
                  Eigen::Vector3d* normal) const;
 
+  /// Whether `p` (in the primitive's frame) lies strictly inside a closed
+  /// shape (box, cylinder); rectangles and triangles contain nothing.
+  bool Contains(const Eigen::Vector3d& p) const;
+
   /// The same primitive expressed in another frame: x_new = R * x + p.
   Primitive Transformed(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) const;
 
