@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -219,11 +220,15 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     if (status.ok()) {
       std::printf("  %s\n", frame.Summary().c_str());
       char nees[128];
-      if (frame.same_frame) {
+      if (frame.same_frame && std::isfinite(cs.mean_position_nees_aligned)) {
         std::snprintf(nees, sizeof(nees),
                       "%.2f (expected %.0f; %.2f after the gauge alignment, %.3f deg)",
                       cs.mean_position_nees, cs.expected_position_nees,
                       cs.mean_position_nees_aligned, cs.gauge_rotation_deg);
+      } else if (frame.same_frame) {
+        std::snprintf(nees, sizeof(nees),
+                      "%.2f (expected %.0f; no gauge alignment: the path fixes no rotation)",
+                      cs.mean_position_nees, cs.expected_position_nees);
       } else {
         std::snprintf(nees, sizeof(nees), "n/a (frames differ)");
       }
