@@ -1,13 +1,13 @@
 #include "swarmlio/replay/consistency.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
 #include "swarmlio/math/so3.h"
+#include "swarmlio/math/umeyama.h"
 
 namespace swarmlio::replay {
 
@@ -157,32 +157,28 @@ Status EvaluateConsistency(const std::vector<ScanRecord>& scans,
   s.rotation_rmse_deg = std::sqrt(sum_rot_sq / s.num_poses);
 
   // Gauge-aligned NEES: the ground truth rotated about the first pose onto the
-  // estimate (Kabsch on the displacements from the first pose; the first
-  // positions coincide in G). Refused when the displacements do not fix a
-  // rotation (second singular value of their scatter below 0.01 m^2).
+  // estimate (the first positions coincide in G), fitted to the displacements
+  // from the first pose. Refused when they do not fix a rotation.
   s.mean_position_nees_aligned = std::numeric_limits<double>::quiet_NaN();
   const int n = s.num_poses;
-  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero(), scatter = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3Xd truth_moves(3, n), estimated_moves(3, n);
   for (int k = 0; k < n; ++k) {
-    const Eigen::Vector3d a = truth_positions[k] - truth_positions[0];
-    const Eigen::Vector3d b = estimated_positions[k] - estimated_positions[0];
-    cross += b * a.transpose();
-    scatter += a * a.transpose() / n;
+    truth_moves.col(k) = truth_positions[k] - truth_positions[0];
+    estimated_moves.col(k) = estimated_positions[k] - estimated_positions[0];
   }
-  const Eigen::JacobiSVD<Eigen::Matrix3d> scatter_svd(scatter);
-  if (n >= 3 && scatter_svd.singularValues()(1) >= 0.01) {
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
-    S(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
-    const Eigen::Matrix3d R = svd.matrixU() * S * svd.matrixV().transpose();
+  UmeyamaOptions about_start;
+  about_start.with_translation = false;
+  about_start.min_second_singular_value_m2 = 0.01;
+  UmeyamaResult gauge;
+  if (AlignUmeyama(truth_moves, estimated_moves, about_start, &gauge).ok()) {
     double sum_aligned = 0.0;
     for (int k = 0; k < n; ++k) {
-      const Eigen::Vector3d e = estimated_positions[k] - estimated_positions[0] -
-                                R * (truth_positions[k] - truth_positions[0]);
+      const Eigen::Vector3d e = estimated_moves.col(k) - gauge.R_dst_src * truth_moves.col(k);
       sum_aligned += e.dot(factors[k].solve(e));
     }
     s.mean_position_nees_aligned = sum_aligned / n;
-    s.gauge_rotation_deg = so3::Log(Eigen::Quaterniond(R)).norm() * 180.0 / M_PI;
+    s.gauge_rotation_deg =
+        so3::Log(Eigen::Quaterniond(gauge.R_dst_src)).norm() * 180.0 / M_PI;
   }
   *stats = s;
   return Status::Ok();

@@ -40,6 +40,33 @@ TEST(Umeyama, RecoversRigidAndSimilarityTransforms) {
   }
 }
 
+// Without translation: the rotation (and scale) about the origin, t = 0; an
+// offset between the sets is left in the residual, not absorbed.
+TEST(Umeyama, AboutTheOriginWithoutTranslation) {
+  std::mt19937 rng(11);
+  const Eigen::Matrix3Xd src = RandomPoints(20, &rng);
+  const Eigen::Matrix3d R = so3::Exp(Eigen::Vector3d(0.3, -0.2, 1.1));
+  UmeyamaOptions options;
+  options.with_translation = false;
+  for (const bool with_scale : {false, true}) {
+    options.with_scale = with_scale;
+    const double s = with_scale ? 0.8 : 1.0;
+    const Eigen::Matrix3Xd dst = (s * R) * src;
+    UmeyamaResult result;
+    ASSERT_TRUE(AlignUmeyama(src, dst, options, &result).ok());
+    EXPECT_LT((result.R_dst_src - R).norm(), 1e-9);
+    EXPECT_EQ(result.t_dst_src, Eigen::Vector3d::Zero());
+    EXPECT_NEAR(result.scale, s, 1e-9);
+    EXPECT_LT(result.rms_residual_m, 1e-9);
+  }
+  options.with_scale = false;
+  Eigen::Matrix3Xd shifted = R * src;
+  shifted.colwise() += Eigen::Vector3d(0.5, 0.0, 0.0);
+  UmeyamaResult result;
+  ASSERT_TRUE(AlignUmeyama(src, shifted, options, &result).ok());
+  EXPECT_GT(result.rms_residual_m, 0.1);
+}
+
 TEST(Umeyama, NeverReturnsAReflection) {
   std::mt19937 rng(3);
   const Eigen::Matrix3Xd src = RandomPoints(10, &rng);

@@ -200,7 +200,7 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
       {"realtime_factor", "real-time factor", 1},
       {"ground_truth_frame", "ground-truth frame", 0},
       {"nees_position", "position NEES in G (3 expected)", 2},
-      {"nees_position_aligned", "position NEES, SE(3) gauge aligned", 2}};
+      {"nees_position_aligned", "position NEES, gauge-aligned", 2}};
   extra_columns.push_back({"messages_received", "msgs received", 0});
   eval::MetricsTable table;
   Status status = eval::MakeDroneMetricsTable(metrics, metric_options, extra_columns, &table);

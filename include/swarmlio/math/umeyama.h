@@ -9,6 +9,9 @@
 // the solution is R = U S V^T, s = tr(D S) / sigma_x^2, t = mu_y - s R mu_x.
 // This is the alignment evo and TUM's evaluate_ate.py use; the arithmetic is
 // Eigen::umeyama's, wrapped with input checks and a degeneracy test.
+// Without translation (with_translation = false) the same solution about the
+// origin: mu_x = mu_y = 0 above, t = 0 (a rotation, or similarity, about a
+// point both sets share, e.g. a trajectory's first pose).
 //
 // Used by trajectory evaluation (APE alignment) and by teammate identification
 // (trajectory matching, src = positions in G_j, dst = positions in G_i, which
@@ -28,7 +31,8 @@ struct UmeyamaResult {
   double scale = 1.0;
   /// Root mean square of |dst_i - (s R src_i + t)| at the solution (m).
   double rms_residual_m = 0.0;
-  /// Singular values of the source scatter (1/n) sum (x - mu)(x - mu)^T,
+  /// Singular values of the source scatter (1/n) sum (x - mu)(x - mu)^T
+  /// (mu = 0 without translation),
   /// descending (m^2): how well the source set constrains the rotation.
   Eigen::Vector3d source_scatter_singular_values = Eigen::Vector3d::Zero();
 
@@ -38,6 +42,9 @@ struct UmeyamaResult {
 
 struct UmeyamaOptions {
   bool with_scale = false;
+  /// false: no translation; the sets are not centred, the scatter and the
+  /// degeneracy test are taken about the origin.
+  bool with_translation = true;
   /// The alignment is refused when the second largest singular value of the
   /// source scatter is below this (m^2): collinear or coincident points leave
   /// a rotation about their line undetermined. 0 accepts any set of >= 3 points.

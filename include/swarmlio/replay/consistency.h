@@ -15,11 +15,12 @@
 // the map through the LiDAR-IMU calibration, so a calibration rotation error
 // dR rotates every later position about the start (|p| dR: 0.30 m at 40 m for
 // 0.44 deg in corridor seed 103), which no covariance of a LIO represents
-// (the map is not in the state). The gauge-aligned NEES therefore first moves
-// the ground truth into the estimate's frame by the SE(3) that best fits the
-// positions (Umeyama), as OpenVINS' ov_eval does before its NEES
-// (ResultTrajectory::calculate_nees uses the ground truth aligned to the
-// estimate). Both are reported; docs/results.md says which band uses which.
+// (the map is not in the state). The gauge-aligned NEES therefore first
+// rotates the ground truth about the first pose onto the estimate (the
+// rotation that best fits the displacements from the first pose: AlignUmeyama
+// without translation), as OpenVINS' ov_eval aligns the ground truth to the
+// estimate before its NEES (ResultTrajectory::calculate_nees). Both are
+// reported; docs/results.md says which band uses which.
 #pragma once
 
 #include <string>
@@ -37,9 +38,10 @@ struct ConsistencyStats {
   double position_rmse_m = 0.0;     // no alignment
   double position_max_m = 0.0;
   double mean_position_nees = 0.0;  // in G, no alignment; expected 3
-  /// After aligning the ground truth onto the estimate by SE(3) (the gauge);
-  /// NaN when the positions do not fix a rotation (a hover: second singular
-  /// value of their scatter below 0.01 m^2) or fewer than 3 poses.
+  /// After rotating the ground truth about the first pose onto the estimate
+  /// (the gauge); NaN when the displacements do not fix a rotation (a hover
+  /// or a line: second singular value of their scatter about the first pose
+  /// below 0.01 m^2) or fewer than 3 poses.
   double mean_position_nees_aligned = 0.0;
   double gauge_rotation_deg = 0.0;  // the rotation of that alignment
   double expected_position_nees = 3.0;
