@@ -120,11 +120,32 @@ bool LocalMap::Insert(const Eigen::Vector3d& point_in_G, double observed_range_m
   if ((point_in_G - m.center).cwiseAbs().maxCoeff() > options_.half_extent_m) return false;
   auto [leaf, inserted] = m.leaf_counts.try_emplace(VoxelKeyOf(point_in_G, m.inv_leaf), 0u);
   (void)inserted;
-  if (leaf->second >= static_cast<uint32_t>(options_.max_points_per_leaf)) return false;
+  const bool known = std::isfinite(observed_range_m) && observed_range_m > 0.0;
+  if (leaf->second >= static_cast<uint32_t>(options_.max_points_per_leaf)) {
+    // Full leaf: a point seen from much closer replaces the leaf's point seen
+    // from farthest (its angular noise is range x angle).
+    if (!(options_.replace_range_ratio > 0.0) || !known) return false;
+    auto it = m.cells.find(VoxelKeyOf(point_in_G, m.inv_cell));
+    if (it == m.cells.end()) return false;
+    Cell& cell = it.value();
+    const VoxelKey leaf_key = leaf->first;
+    int worst = -1;
+    float worst_range = 0.0f;
+    for (size_t i = 0; i < cell.points_in_G.size(); ++i) {
+      const float r = cell.observed_ranges_m[i];
+      if (r > worst_range && VoxelKeyOf(cell.points_in_G[i], m.inv_leaf) == leaf_key) {
+        worst = static_cast<int>(i);
+        worst_range = r;
+      }
+    }
+    if (worst < 0 || !(observed_range_m < options_.replace_range_ratio * worst_range)) return false;
+    cell.points_in_G[static_cast<size_t>(worst)] = point_in_G;
+    cell.observed_ranges_m[static_cast<size_t>(worst)] = static_cast<float>(observed_range_m);
+    return true;
+  }
   ++leaf.value();
   Cell& cell = m.cells[VoxelKeyOf(point_in_G, m.inv_cell)];
   cell.points_in_G.push_back(point_in_G);
-  const bool known = std::isfinite(observed_range_m) && observed_range_m > 0.0;
   cell.observed_ranges_m.push_back(known ? static_cast<float>(observed_range_m) : 0.0f);
   ++m.num_points;
   return true;

@@ -178,6 +178,9 @@ TEST(LocalMapTest, OptionsValidate) {
   o = LocalMapOptions();
   o.leaf_size_m = -1.0;
   EXPECT_NE(o.Validate().find("leaf_size_m"), std::string::npos);
+  o = LocalMapOptions();
+  o.replace_range_ratio = 1.5;
+  EXPECT_NE(o.Validate().find("replace_range_ratio"), std::string::npos);
 }
 
 TEST(LocalMapTest, KNearestReturnsTheRangeEachPointWasObservedFrom) {
@@ -192,6 +195,41 @@ TEST(LocalMapTest, KNearestReturnsTheRangeEachPointWasObservedFrom) {
     const bool observed = nb.point_in_G.x() < 0.5;
     EXPECT_FLOAT_EQ(nb.observed_range_m, observed ? 12.5f : 0.0f) << nb.point_in_G.transpose();
   }
+}
+
+// replace_range_ratio: a full leaf's farthest-observed point gives way to one
+// observed from closer than ratio x its range; nothing else changes.
+TEST(LocalMapTest, ANearerObservationReplacesTheFarthestInAFullLeaf) {
+  LocalMapOptions o;
+  o.leaf_size_m = 0.5;
+  o.max_points_per_leaf = 2;
+  o.replace_range_ratio = 0.5;
+  LocalMap map(o);
+  ASSERT_TRUE(map.Insert(Eigen::Vector3d(0.1, 0.1, 0.1), 40.0));
+  ASSERT_TRUE(map.Insert(Eigen::Vector3d(0.2, 0.1, 0.1), 30.0));
+  ASSERT_TRUE(map.Insert(Eigen::Vector3d(0.6, 0.1, 0.1), 40.0));        // the next leaf
+  EXPECT_FALSE(map.Insert(Eigen::Vector3d(0.3, 0.1, 0.1), 20.0));       // not below 0.5 x 40
+  EXPECT_FALSE(map.Insert(Eigen::Vector3d(0.3, 0.1, 0.1)));             // range unknown
+  EXPECT_TRUE(map.Insert(Eigen::Vector3d(0.4, 0.1, 0.1), 19.0));        // replaces the 40 m one
+  EXPECT_EQ(map.size(), 3u);
+  std::vector<Neighbor> nn;
+  ASSERT_EQ(map.KNearest(Eigen::Vector3d(0.25, 0.1, 0.1), 3, &nn), 3);
+  std::vector<float> ranges;
+  for (const Neighbor& nb : nn) {
+    EXPECT_NE(nb.point_in_G, Eigen::Vector3d(0.1, 0.1, 0.1));          // the one replaced
+    ranges.push_back(static_cast<float>(nb.observed_range_m));
+  }
+  std::sort(ranges.begin(), ranges.end());
+  EXPECT_EQ(ranges, (std::vector<float>{19.0f, 30.0f, 40.0f}));         // 40: the other leaf
+  EXPECT_TRUE(map.Insert(Eigen::Vector3d(0.1, 0.4, 0.1), 14.0));        // now the 30 m one
+  EXPECT_FALSE(map.Insert(Eigen::Vector3d(0.1, 0.3, 0.1), 10.0));       // 10 >= 0.5 x 19
+  EXPECT_EQ(map.size(), 3u);
+
+  o.replace_range_ratio = 0.0;  // off: first come, first kept
+  LocalMap off(o);
+  ASSERT_TRUE(off.Insert(Eigen::Vector3d(0.1, 0.1, 0.1), 40.0));
+  ASSERT_TRUE(off.Insert(Eigen::Vector3d(0.2, 0.1, 0.1), 30.0));
+  EXPECT_FALSE(off.Insert(Eigen::Vector3d(0.4, 0.1, 0.1), 1.0));
 }
 
 }  // namespace

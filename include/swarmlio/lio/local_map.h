@@ -9,7 +9,9 @@
 // Insertion rule (FAST-LIO filter_size_map): a point is added only if its
 // leaf voxel (side leaf_size_m, [k*leaf, (k+1)*leaf) per axis) holds fewer
 // than max_points_per_leaf points; otherwise it is dropped (first come, first
-// kept). Points outside the current box (below) and non-finite points are
+// kept), or, with replace_range_ratio r > 0, it replaces the leaf's point
+// observed from farthest when its own range is below r times that range
+// (off by default: docs/local_map.md). Points outside the current box (below) and non-finite points are
 // dropped too. Each point keeps the LiDAR range it was observed from
 // (returned with it by KNearest): a LiDAR's angular noise displaces a point by
 // range x angle, which the plane fit's normal noise model uses.
@@ -45,6 +47,9 @@ namespace swarmlio::lio {
 struct LocalMapOptions {
   double leaf_size_m = 0.5;        // insertion downsampling voxel (filter_size_map) [m]
   int max_points_per_leaf = 1;     // points kept per leaf voxel
+  // A point observed from less than this times the range of a full leaf's
+  // farthest-observed point replaces it; 0 = off (first come, first kept) [-].
+  double replace_range_ratio = 0.0;
   double cell_size_m = 0.0;        // search-grid cell side; 0 = 4 * leaf_size_m [m]
   double half_extent_m = 100.0;    // half side of the kept cube (cube_side_length / 2) [m]
   double prune_distance_m = 5.0;   // prune after the centre moved this far [m]
@@ -57,6 +62,10 @@ struct LocalMapOptions {
       FieldSpec::Positive("m", "insertion downsampling voxel (filter_size_map)").WithMax(100.0));
     v("max_points_per_leaf", max_points_per_leaf,
       FieldSpec::InRange(1.0, 1000.0, "", "points kept per leaf voxel; more are dropped"));
+    v("replace_range_ratio", replace_range_ratio,
+      FieldSpec::InRange(0.0, 1.0, "",
+                         "a full leaf's farthest-observed point is replaced by one observed from "
+                         "closer than this times its range; 0 = first come, first kept"));
     v("cell_size_m", cell_size_m,
       FieldSpec::InRange(0.0, 100.0, "m",
                          "side of the hash-grid search cells; 0 = 4 * leaf_size_m (fastest "
