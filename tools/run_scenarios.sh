@@ -9,6 +9,12 @@
 #   tools/run_scenarios.sh indoor_3uav     # only the named ones
 #   SEED_OFFSETS="0" tools/run_scenarios.sh    # only the seed in each file
 #   IMPERFECTIONS=ideal tools/run_scenarios.sh # the simulator preset (default: the scenario's)
+#   # An ablation: the realistic preset without one imperfection, in its own
+#   # table (IMPERFECTIONS_YAML is appended to each scenario as its
+#   # `imperfections:` map, docs/simulator.md; SINGLE_AGENT=0 skips the
+#   # single-agent replays):
+#   IMPERFECTIONS_YAML='{preset: realistic, lidar: {angular_noise_deg: 0}}' SINGLE_AGENT=0 \
+#     DOC=docs/results_ablation.md OUT=/tmp/ablation tools/run_scenarios.sh exploration
 #
 # Seeds: the scenario file's own seed plus each offset in SEED_OFFSETS
 # (default "0 100 200 300"); the seed drives the sensor noise and the random
@@ -24,6 +30,12 @@ OUT="${OUT:-$ROOT/results/scenarios}"
 DOC="${DOC:-$ROOT/docs/results_scenarios.md}"
 SEED_OFFSETS="${SEED_OFFSETS:-0 100 200 300}"
 IMPERFECTIONS="${IMPERFECTIONS:-}"
+IMPERFECTIONS_YAML="${IMPERFECTIONS_YAML:-}"
+SINGLE_AGENT="${SINGLE_AGENT:-1}"
+if [[ -n "$IMPERFECTIONS" && -n "$IMPERFECTIONS_YAML" ]]; then
+  echo "set IMPERFECTIONS or IMPERFECTIONS_YAML, not both" >&2
+  exit 1
+fi
 SIM="$BUILD_DIR/tools/sim/swarmlio_sim"
 REPLAY="$BUILD_DIR/tools/replay/swarmlio_replay"
 
@@ -49,6 +61,7 @@ file_seed() {
 stats() {
   local column="$1" drone="$2"
   shift 2
+  if [[ $# -eq 0 ]]; then printf "n/a"; return; fi
   awk -F, -v col="$column" -v d="$drone" '
     FNR == 1 { for (i = 1; i <= NF; ++i) if ($i == col) c = i; next }
     $1 == d && c > 0 && $c ~ /^[-+0-9.eE]+$/ { v = $c + 0; n++; s += v; ss += v * v;
@@ -70,6 +83,7 @@ stats() {
   echo "replays run on one core with \`taskset -c 0\`). Do not edit by hand."
   echo
   preset="${IMPERFECTIONS:-as in each scenario file (simulator default)}"
+  [[ -n "$IMPERFECTIONS_YAML" ]] && preset="\`imperfections: $IMPERFECTIONS_YAML\` appended to each scenario file"
   echo "Simulator preset: $preset. Seeds: each scenario's"
   echo "file seed plus the offsets ${SEED_OFFSETS}. Tuning set: \`indoor_3uav\`, \`corridor\` and"
   echo "\`exploration\` with their file seeds, and \`corridor\` seed 103; every other seed and scenario is"
@@ -97,14 +111,21 @@ for name in "${scenarios[@]}"; do
     ln -sf "$ROOT"/configs/*.yaml "$OUT/$name/"
     sed -E "/^scenario:/,/^[a-z]/s/seed: *[0-9]+/seed: $seed/" "$scenario" > "$variant"
     grep -qE "seed: $seed([^0-9]|\$)" "$variant" || { echo "could not set seed in $variant" >&2; exit 1; }
+    if [[ -n "$IMPERFECTIONS_YAML" ]]; then
+      grep -q '^imperfections:' "$variant" &&
+        { echo "$scenario has its own imperfections: key; IMPERFECTIONS_YAML would repeat it" >&2; exit 1; }
+      echo "imperfections: $IMPERFECTIONS_YAML" >> "$variant"
+    fi
     sim_args=(--scenario "$variant" --output_dir "$dir/sim")
     [[ -n "$IMPERFECTIONS" ]] && sim_args+=(--imperfections "$IMPERFECTIONS")
     "$SIM" "${sim_args[@]}" > "$dir/sim.log" 2>&1 || { notes+=("seed $seed: simulation failed"); continue; }
     status=0
     taskset -c 0 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/swarm" \
       --save_maps=false > "$dir/swarm.log" 2>&1 || status=$?
-    taskset -c 0 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/single" \
-      --single_agent --save_maps=false > "$dir/single.log" 2>&1 || status=$?
+    if [[ "$SINGLE_AGENT" != 0 ]]; then
+      taskset -c 0 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/single" \
+        --single_agent --save_maps=false > "$dir/single.log" 2>&1 || status=$?
+    fi
     [[ $status -eq 0 ]] || notes+=("seed $seed: replay exit status $status")
     [[ -f "$dir/swarm/metrics.csv" ]] && swarm_csvs+=("$dir/swarm/metrics.csv")
     [[ -f "$dir/single/metrics.csv" ]] && single_csvs+=("$dir/single/metrics.csv")
@@ -115,9 +136,11 @@ for name in "${scenarios[@]}"; do
     echo
     echo '```sh'
     echo "# per seed S: configs/scenarios/$name.yaml with seed: S, in $OUT/$name/seedS/"
+    [[ -n "$IMPERFECTIONS_YAML" ]] && echo "# with the line 'imperfections: $IMPERFECTIONS_YAML' appended"
     echo "build/tools/sim/swarmlio_sim --scenario $name.yaml --output_dir sim${IMPERFECTIONS:+ --imperfections $IMPERFECTIONS}"
     echo "taskset -c 0 build/tools/replay/swarmlio_replay --manifest sim/swarm.yaml --output_dir swarm --save_maps=false"
-    echo "taskset -c 0 build/tools/replay/swarmlio_replay --manifest sim/swarm.yaml --output_dir single --single_agent --save_maps=false"
+    [[ "$SINGLE_AGENT" != 0 ]] &&
+      echo "taskset -c 0 build/tools/replay/swarmlio_replay --manifest sim/swarm.yaml --output_dir single --single_agent --save_maps=false"
     echo '```'
     echo
     if [[ ${#notes[@]} -gt 0 ]]; then printf -- '- %s\n' "${notes[@]}"; fi
