@@ -218,14 +218,24 @@ Status Odometry::Flush() {
 
 int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const EgoState& x,
                          const std::vector<ExcludedRegion>& excluded,
-                         std::vector<Eigen::Vector3d>* registered_out) {
+                         std::vector<Eigen::Vector3d>* registered_out,
+                         const std::vector<int>* skip_indices) {
   const Eigen::Matrix3d R_G_b = x.q_G_b.toRotationMatrix();
   std::vector<Eigen::Vector3d> registered;
   std::vector<double> ranges;  // from the body origin: the LiDAR's within its lever arm
   registered.reserve(points_in_b.size());
   ranges.reserve(points_in_b.size());
+  if (registered_out != nullptr) registered_out->clear();
+  std::vector<bool> skip;
+  if (skip_indices != nullptr) {
+    skip.assign(points_in_b.size(), false);
+    for (int i : *skip_indices) {
+      if (i >= 0 && static_cast<size_t>(i) < skip.size()) skip[static_cast<size_t>(i)] = true;
+    }
+  }
   int num_excluded = 0;
-  for (const Eigen::Vector3d& p : points_in_b) {
+  for (size_t i = 0; i < points_in_b.size(); ++i) {
+    const Eigen::Vector3d& p = points_in_b[i];
     bool inside = false;
     for (const ExcludedRegion& region : excluded) {
       inside |= (p - region.center_in_b).squaredNorm() <= region.radius_m * region.radius_m;
@@ -234,12 +244,18 @@ int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const 
       ++num_excluded;
       continue;
     }
+    if (!skip.empty() && skip[i]) {
+      if (registered_out != nullptr) registered_out->push_back(R_G_b * p + x.p_b_in_G);
+      continue;
+    }
     registered.push_back(R_G_b * p + x.p_b_in_G);
     ranges.push_back(p.norm());
   }
   impl_->map.UpdateCenter(x.p_b_in_G);
   impl_->map.Insert(registered, &ranges);
-  if (registered_out != nullptr) *registered_out = std::move(registered);
+  if (registered_out != nullptr) {
+    registered_out->insert(registered_out->end(), registered.begin(), registered.end());
+  }
   return num_excluded;
 }
 
@@ -424,9 +440,14 @@ void Odometry::UpdateWithFilter(const UpdateRequest& request, SwarmState* x_io,
   // misregistered scan into it.
   const Clock::time_point t = Clock::now();
   if (out->updated || !map_ready) {
+    // Without insert_matched_points, the points the update matched to a map
+    // plane stay out of the map (the map explains them already).
+    const std::vector<int>* matched =
+        options_.insert_matched_points || !out->updated ? nullptr
+                                                         : &im.associator.matched_point_indices();
     out->num_excluded_points = InsertScan(
         im.undistorted, x.ego, request.excluded,
-        options_.output_registered_scan ? &out->registered_in_G : nullptr);
+        options_.output_registered_scan ? &out->registered_in_G : nullptr, matched);
   }
   out->timings.map_update_s = SecondsSince(t);
 }

@@ -33,6 +33,7 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
   stats_.num_points = static_cast<int>(points.size());
   out->reserve(points.size());
   planes_.clear();
+  matched_.clear();
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d q_in_G = R_G_b * points[i] + p_b_in_G;
     CachedPlane& cached = cache_[i];
@@ -58,6 +59,7 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
     c.weight = weight;
     out->push_back(c);
     planes_.push_back(&cached.plane);
+    matched_.push_back(static_cast<int>(i));
   }
   if (options_.max_normal_stddev_rad > 0.0) ApplyNoisyPlaneRule(out);
   for (const PlaneCorrespondence& c : *out) {
@@ -128,9 +130,11 @@ void ScanAssociator::ApplyNoisyPlaneRule(std::vector<PlaneCorrespondence>* out) 
         ++stats_.num_tilt_projected;
       }
     }
+    matched_[kept] = matched_[i];
     (*out)[kept++] = c;
   }
   out->resize(kept);
+  matched_.resize(kept);
 }
 
 }  // namespace swarmlio::lio

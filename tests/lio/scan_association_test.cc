@@ -172,5 +172,45 @@ TEST(ScanAssociationTest, AnEndWallKeepsItsInformationAlongTheAxis) {
             0.1 * (drop.x_information - drop.end_wall_x_information));
 }
 
+// matched_point_indices(): for each correspondence, its scan point, also after
+// the noisy-plane rule dropped some (the odometry keeps those points out of
+// the map, odometry_options.h insert_matched_points).
+TEST(ScanAssociationTest, MatchedPointIndicesNameEachCorrespondencesScanPoint) {
+  LocalMapOptions map_options;
+  map_options.leaf_size_m = 0.3;
+  LocalMap map(map_options);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.065);  // mapped from 25 m
+  std::vector<Eigen::Vector3d> mapped;
+  std::vector<double> ranges;
+  for (Eigen::Vector3d p : CorridorPoints(8.0, false, 0.1)) {
+    p(std::abs(std::abs(p.y()) - 1.2) < 1e-9 ? 1 : 2) += noise(rng);
+    mapped.push_back(p);
+    ranges.push_back(25.0);
+  }
+  map.Insert(mapped, &ranges);
+  std::vector<Eigen::Vector3d> scan;
+  for (const Eigen::Vector3d& p : CorridorPoints(8.0, false, 0.37)) {
+    scan.push_back(p - Eigen::Vector3d(0.0, 0.0, 1.5));
+  }
+  scan.push_back(Eigen::Vector3d(0.0, 0.0, 40.0));  // far from the map: no plane
+  ScanAssociator associator(&map, RuleOptions(0.2, 3.0));
+  associator.Reset(&scan);
+  SwarmState x;
+  x.ego.p_b_in_G = Eigen::Vector3d(0.0, 0.0, 1.5);
+  std::vector<PlaneCorrespondence> correspondences;
+  ASSERT_TRUE(associator.Associate(x, &correspondences).ok());
+  ASSERT_GT(associator.stats().num_tilt_gated, 0);  // the rule dropped some
+  const std::vector<int>& matched = associator.matched_point_indices();
+  ASSERT_EQ(matched.size(), correspondences.size());
+  ASSERT_GT(matched.size(), 10u);
+  for (size_t k = 0; k < matched.size(); ++k) {
+    ASSERT_GE(matched[k], 0);
+    ASSERT_LT(static_cast<size_t>(matched[k]), scan.size() - 1);  // never the far point
+    EXPECT_EQ(scan[static_cast<size_t>(matched[k])], correspondences[k].p_in_b) << k;
+    if (k > 0) EXPECT_LT(matched[k - 1], matched[k]);
+  }
+}
+
 }  // namespace
 }  // namespace swarmlio::lio

@@ -180,11 +180,14 @@ class Odometry {
                         ScanOutput* out);
   void UpdateWithWindow(const UpdateRequest& request, SwarmState* x, Eigen::MatrixXd* P,
                         ScanOutput* out);
-  // Registers the points with x, inserts all but the excluded ones into the
-  // map (moving its box to x) and returns how many were excluded.
+  // Registers the points with x, inserts all but the excluded ones and those
+  // listed in skip_indices into the map (moving its box to x) and returns how
+  // many were excluded. registered_in_G (cleared) gets every point not
+  // excluded.
   int InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const EgoState& x,
                  const std::vector<ExcludedRegion>& excluded,
-                 std::vector<Eigen::Vector3d>* registered_in_G);
+                 std::vector<Eigen::Vector3d>* registered_in_G,
+                 const std::vector<int>* skip_indices = nullptr);
 
   OdometryOptions options_;
   LidarOptions lidar_;

@@ -146,6 +146,10 @@ class ScanAssociator {
   /// Statistics of the last Associate() call.
   const AssociationStats& stats() const { return stats_; }
 
+  /// For each correspondence of the last Associate() call, in its order, the
+  /// index of its point in the scan given to Reset().
+  const std::vector<int>& matched_point_indices() const { return matched_; }
+
  private:
   struct CachedPlane {
     Eigen::Vector3d searched_at_in_G = Eigen::Vector3d::Constant(1e300);
@@ -165,6 +169,7 @@ class ScanAssociator {
   std::vector<CachedPlane> cache_;
   std::vector<Neighbor> neighbors_;  // scratch
   std::vector<const Plane*> planes_;  // scratch: the plane of each correspondence
+  std::vector<int> matched_;          // the scan point of each correspondence
   AssociationStats stats_;
 };
 
