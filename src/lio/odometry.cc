@@ -210,7 +210,8 @@ Status Odometry::Flush() {
     std::vector<internal::LeavingScan> scans;
     impl_->window->TakeScansForMap(&scans);
     for (const internal::LeavingScan& s : scans) {
-      InsertScan(s.points_in_b, s.state, s.excluded, nullptr);
+      InsertScan(s.points_in_b, s.state, s.excluded, nullptr,
+                 options_.insert_matched_points ? nullptr : &s.matched);
     }
   }
   return status;
@@ -483,7 +484,10 @@ void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
   // newest scan at its prediction, like the filter's first scan.
   Clock::time_point t = Clock::now();
   for (const internal::LeavingScan& l : leaving) {
-    if (l.insert) InsertScan(l.points_in_b, l.state, l.excluded, nullptr);
+    if (l.insert) {
+      InsertScan(l.points_in_b, l.state, l.excluded, nullptr,
+                 options_.insert_matched_points ? nullptr : &l.matched);
+    }
   }
   if (im.map.empty()) {
     out->num_excluded_points = InsertScan(im.undistorted, x.ego, request.excluded, nullptr);

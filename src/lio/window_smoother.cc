@@ -173,6 +173,7 @@ void WindowSmoother::Impl::Leave(WindowScan* scan, std::vector<LeavingScan>* lea
   if (out.insert) {
     out.points_in_b = std::move(scan->points_in_b);
     out.excluded = std::move(scan->excluded);
+    if (scan->associator != nullptr) out.matched = scan->associator->matched_point_indices();
   }
   leaving->push_back(std::move(out));
 }

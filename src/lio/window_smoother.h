@@ -46,6 +46,7 @@ struct LeavingScan {
   std::vector<Eigen::Vector3d> points_in_b;  // undistorted, body frame at the scan end
   std::vector<ExcludedRegion> excluded;
   bool insert = false;  // updated by a solve and not in the map yet
+  std::vector<int> matched;  // points matched to a map plane at its last association
 };
 
 /// The newest scan state.

@@ -53,12 +53,13 @@ struct OdometryOptions {
   /// a sparse map whose plane fits tilt the first registrations (0.2 deg on
   /// the simulated Avia); the window's scans make it dense at no risk.
   bool seed_map_from_static_start = true;
-  /// Filter back end: insert also the scan points that the update matched to
-  /// a map plane. FAST-LIO2 inserts every point; off (the default), only the
-  /// points the map does not explain yet enter it, so that a revisit with a
-  /// different pose error does not write a second copy of a surface whose
-  /// streaks then fit planes facing the wrong way (docs/lio.md "Map
-  /// insertion"). The window back end inserts every point.
+  /// Insert also the scan points that the update matched to a map plane.
+  /// FAST-LIO2 inserts every point; off (the default), only the points the
+  /// map does not explain yet enter it, so that a revisit with a different
+  /// pose error does not write a second copy of a surface whose streaks then
+  /// fit planes facing the wrong way (docs/lio.md "Map insertion"). The
+  /// window back end applies it to each scan leaving the window, with that
+  /// scan's last association.
   bool insert_matched_points = false;
 
   template <class V>
@@ -89,8 +90,8 @@ struct OdometryOptions {
       FieldSpec::Doc("insert the scans inside the static IMU-initialization window into the map "
                      "at the initial pose"));
     v("insert_matched_points", insert_matched_points,
-      FieldSpec::Doc("filter: also insert the scan points matched to a map plane (FAST-LIO2); "
-                     "false: only the points the map does not explain"));
+      FieldSpec::Doc("also insert the scan points matched to a map plane (FAST-LIO2); false: "
+                     "only the points the map does not explain"));
   }
 
   /// "" when valid, else "key: reason".
