@@ -208,7 +208,9 @@ TEST(ScanAssociationTest, MatchedPointIndicesNameEachCorrespondencesScanPoint) {
     ASSERT_GE(matched[k], 0);
     ASSERT_LT(static_cast<size_t>(matched[k]), scan.size() - 1);  // never the far point
     EXPECT_EQ(scan[static_cast<size_t>(matched[k])], correspondences[k].p_in_b) << k;
-    if (k > 0) EXPECT_LT(matched[k - 1], matched[k]);
+    if (k > 0) {
+      EXPECT_LT(matched[k - 1], matched[k]);
+    }
   }
 }
 
