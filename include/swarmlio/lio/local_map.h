@@ -11,8 +11,9 @@
 // than max_points_per_leaf points; otherwise it is dropped (first come, first
 // kept), or, with replace_range_ratio r > 0, it replaces the leaf's point
 // observed from farthest when its own range is below r times that range
-// (off by default: docs/local_map.md). Points outside the current box (below) and non-finite points are
-// dropped too. Each point keeps the LiDAR range it was observed from
+// (off by default: docs/local_map.md). Points outside the current box
+// (below) and non-finite points are dropped too. Each point keeps the LiDAR
+// range it was observed from
 // (returned with it by KNearest): a LiDAR's angular noise displaces a point by
 // range x angle, which the plane fit's normal noise model uses.
 //
