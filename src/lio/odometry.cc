@@ -245,18 +245,14 @@ int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const 
       ++num_excluded;
       continue;
     }
-    if (!skip.empty() && skip[i]) {
-      if (registered_out != nullptr) registered_out->push_back(R_G_b * p + x.p_b_in_G);
-      continue;
-    }
-    registered.push_back(R_G_b * p + x.p_b_in_G);
+    const Eigen::Vector3d q = R_G_b * p + x.p_b_in_G;
+    if (registered_out != nullptr) registered_out->push_back(q);
+    if (!skip.empty() && skip[i]) continue;
+    registered.push_back(q);
     ranges.push_back(p.norm());
   }
   impl_->map.UpdateCenter(x.p_b_in_G);
   impl_->map.Insert(registered, &ranges);
-  if (registered_out != nullptr) {
-    registered_out->insert(registered_out->end(), registered.begin(), registered.end());
-  }
   return num_excluded;
 }
 
