@@ -54,6 +54,110 @@ TEST(RpeIdPairs, Errors) {
             Status::Code::kFailedPrecondition);
 }
 
+TEST(RpeAllIdPairs, FramesPairEveryPoseWithTheOneDAhead) {
+  std::vector<IdPair> pairs;
+  ASSERT_TRUE(
+      RpeAllIdPairs(AlongX(std::vector<double>(6, 0.0)), 3, DeltaUnit::kFrames, 0.1, &pairs).ok());
+  EXPECT_EQ(pairs, (Pairs{{0, 3}, {1, 4}, {2, 5}}));
+}
+
+TEST(RpeAllIdPairs, MetresTakeTheNearestPathLengthWithinTheTolerance) {
+  // Path lengths from pose 0 (exact binary fractions): 0 0.5 1 1.5 2.25 3 3 3 4.
+  const Trajectory poses = AlongX({0.0, 0.5, 1.0, 1.5, 2.25, 3.0, 3.0, 3.0, 4.0});
+  std::vector<IdPair> pairs;
+  // Tolerance 0.1 m: only the starts with a pose exactly 1 m further on.
+  ASSERT_TRUE(RpeAllIdPairs(poses, 1.0, DeltaUnit::kMeters, 0.1, &pairs).ok());
+  EXPECT_EQ(pairs, (Pairs{{0, 2}, {1, 3}, {5, 8}, {6, 8}, {7, 8}}));
+  // Tolerance 0.3 m: 2 -> 4 (2.25 beats 1.5), 3 -> 4 (the 0.25 m short one
+  // beats the 0.5 m long one), 4 -> 5 (the first pose of the stretch at 3 m).
+  ASSERT_TRUE(RpeAllIdPairs(poses, 1.0, DeltaUnit::kMeters, 0.3, &pairs).ok());
+  EXPECT_EQ(pairs,
+            (Pairs{{0, 2}, {1, 3}, {2, 4}, {3, 4}, {4, 5}, {5, 8}, {6, 8}, {7, 8}}));
+  // A tie (0.75 and 1.25 m from pose 0) goes to the nearer pose.
+  ASSERT_TRUE(RpeAllIdPairs(AlongX({0.0, 0.75, 1.25}), 1.0, DeltaUnit::kMeters, 0.3, &pairs).ok());
+  EXPECT_EQ(pairs, (Pairs{{0, 1}}));
+}
+
+TEST(RpeAllIdPairs, Errors) {
+  const Trajectory poses = AlongX({0.0, 1.0, 2.0});
+  std::vector<IdPair> pairs;
+  EXPECT_EQ(RpeAllIdPairs(poses, 1.0, DeltaUnit::kMeters, 1.0, &pairs).code(),
+            Status::Code::kInvalidArgument);
+  EXPECT_EQ(RpeAllIdPairs(poses, 1.0, DeltaUnit::kMeters, -0.1, &pairs).code(),
+            Status::Code::kInvalidArgument);
+  EXPECT_EQ(RpeAllIdPairs(poses, 1.5, DeltaUnit::kFrames, 0.1, &pairs).code(),
+            Status::Code::kInvalidArgument);
+  EXPECT_EQ(RpeAllIdPairs(poses, 3, DeltaUnit::kFrames, 0.1, &pairs).code(),
+            Status::Code::kFailedPrecondition);
+  EXPECT_EQ(RpeAllIdPairs(poses, 5.0, DeltaUnit::kMeters, 0.1, &pairs).code(),
+            Status::Code::kFailedPrecondition);
+}
+
+TEST(Rpe, AllPairsInMetresMeasureTheDriftPerDistance) {
+  // The estimate runs 1 % long: 0.101 m steps against 0.1 m. Pairs of 2 m of
+  // estimated path are 20 steps (2.02 m, the nearest to 2 m), whose error is
+  // 2.02 - 2.00 = 0.02 m: 1 % of the delta, from every start pose that has
+  // 20 steps ahead (a tolerance of 2 %, 0.04 m, keeps out the last starts'
+  // 19-step pairs, 1.919 m; the default 10 % would take them).
+  std::vector<double> x_reference;
+  std::vector<double> x_estimate;
+  for (int i = 0; i <= 100; ++i) {
+    x_reference.push_back(0.1 * i);
+    x_estimate.push_back(0.101 * i);
+  }
+  RpeOptions options;
+  options.delta = 2.0;
+  options.delta_unit = DeltaUnit::kMeters;
+  options.all_pairs = true;
+  options.all_pairs_relative_tolerance = 0.02;
+  RpeResult result;
+  ASSERT_TRUE(ComputeRpe(AlongX(x_reference), AlongX(x_estimate), options, &result).ok());
+  EXPECT_EQ(result.statistics.count, 81u);  // starts 0..80
+  EXPECT_NEAR(result.statistics.mean / options.delta, 0.01, 1e-9);
+  EXPECT_NEAR(result.statistics.max, 0.02, 1e-9);
+  // Consecutive pairs see the same drift from far fewer segments.
+  options.all_pairs = false;
+  ASSERT_TRUE(ComputeRpe(AlongX(x_reference), AlongX(x_estimate), options, &result).ok());
+  EXPECT_LT(result.statistics.count, 6u);
+}
+
+TEST(Rpe, WorldDisplacementLeavesAConstantAttitudeOffsetOut) {
+  // The estimate has the reference's positions and an attitude 0.5 deg off
+  // about a fixed body axis: the start-pose form sees angle x distance, the
+  // world form nothing.
+  const Trajectory reference = testing::Curve(60);
+  Trajectory estimate = reference;
+  const Eigen::Isometry3d offset = testing::MakePose(
+      Eigen::Vector3d(0.0, 0.0, 0.5 * M_PI / 180.0), Eigen::Vector3d::Zero());
+  for (Eigen::Isometry3d& T : estimate.T_G_b) T = T * offset;
+  RpeOptions options;
+  options.delta = 0.5;
+  options.delta_unit = DeltaUnit::kMeters;
+  options.all_pairs = true;
+  RpeResult result;
+  ASSERT_TRUE(ComputeRpe(reference, estimate, options, &result).ok());
+  EXPECT_GT(result.statistics.mean, 0.5 * 0.5 * 0.5 * M_PI / 180.0);  // > half angle x delta
+  options.translation_in_world = true;
+  ASSERT_TRUE(ComputeRpe(reference, estimate, options, &result).ok());
+  EXPECT_LT(result.statistics.max, 1e-12);
+
+  // A rotation of the whole estimate (the map frame's gauge): the world form
+  // sees it unless the alignment takes it out.
+  Trajectory rotated = reference;
+  const Eigen::Isometry3d T_other_G =
+      testing::MakePose(Eigen::Vector3d(0.0, 0.01, 0.02), Eigen::Vector3d(1.0, 2.0, 0.0));
+  for (Eigen::Isometry3d& T : rotated.T_G_b) T = T_other_G * T;
+  ASSERT_TRUE(ComputeRpe(reference, rotated, options, &result).ok());
+  EXPECT_GT(result.statistics.mean, 0.005);
+  options.alignment = Alignment::kSe3;
+  ASSERT_TRUE(ComputeRpe(reference, rotated, options, &result).ok());
+  EXPECT_LT(result.statistics.max, 1e-9);
+
+  options.relation = PoseRelation::kRotationAngleDeg;
+  EXPECT_EQ(ComputeRpe(reference, rotated, options, &result).code(),
+            Status::Code::kInvalidArgument);
+}
+
 TEST(Rpe, ScaledStepsGiveTheStepDifference) {
   const Trajectory reference = AlongX({0, 1, 2, 3, 4});
   const Trajectory estimate = AlongX({0, 1.25, 2.5, 3.75, 5.0});

@@ -2,7 +2,7 @@
 // reference, with evo's rules and defaults (docs/evaluation.md).
 //
 //   swarmlio_eval ape REF EST [--align=se3] [--relation=trans] [--plot_top_view=a.png] ...
-//   swarmlio_eval rpe REF EST [--delta=1 --delta_unit=m] ...
+//   swarmlio_eval rpe REF EST [--delta=1 --delta_unit=m --all_pairs --rpe_frame=world] ...
 //   swarmlio_eval extrinsics OBSERVER_extrinsics.csv --manifest=swarm.yaml --observer=uav1
 //     (T_Gi_Gj errors against a simulated manifest's true G frames, as the replay reports)
 //
@@ -40,6 +40,14 @@ DEFINE_string(relation,
               "pose relation: trans (m), rot, angle_deg, angle_rad, full (|E - I|_F)");
 DEFINE_double(delta, 1.0, "rpe: delta between the poses of a pair");
 DEFINE_string(delta_unit, "f", "rpe: unit of --delta: f (frames) or m (metres of path)");
+DEFINE_bool(all_pairs, false,
+            "rpe: a pair from every pose instead of consecutive ids (evo --all_pairs); with "
+            "--delta_unit=m, pairs whose path length is within 10 % of --delta, and the mean "
+            "error is also printed as a drift in % of --delta");
+DEFINE_string(rpe_frame, "pose",
+              "rpe: pose (evo: the displacement error in the start pose's frame, with its "
+              "attitude error) or world (the displacement error in the reference frame after "
+              "--align; translation only)");
 DEFINE_double(t_max_diff, 0.01, "maximum |dt| of an associated pair [s]");
 DEFINE_double(t_offset, 0.0, "offset added to the estimate's stamps [s]");
 DEFINE_bool(allow_duplicate_stamps,
@@ -267,15 +275,27 @@ int main(int argc, char** argv) {
   options.association = association;
   options.delta = FLAGS_delta;
   options.delta_unit = delta_unit;
+  options.all_pairs = FLAGS_all_pairs;
+  if (FLAGS_rpe_frame != "pose" && FLAGS_rpe_frame != "world") {
+    return Usage("--rpe_frame '" + FLAGS_rpe_frame + "' is not pose or world");
+  }
+  options.translation_in_world = FLAGS_rpe_frame == "world";
   eval::RpeResult result;
   status = eval::ComputeRpe(reference, estimate, options, &result);
   if (!status.ok()) return Fail(status.message());
-  std::printf("RPE w.r.t. %s%s%s for delta = %g %s (consecutive pairs)\n",
+  std::printf("RPE w.r.t. %s%s%s for delta = %g %s (%s pairs, %s)\n",
               eval::PoseRelationName(relation), *unit ? " in " : "", unit, FLAGS_delta,
-              eval::DeltaUnitName(delta_unit));
+              eval::DeltaUnitName(delta_unit), FLAGS_all_pairs ? "all" : "consecutive",
+              options.translation_in_world ? "displacement in the world frame"
+                                           : "in the start pose's frame");
   std::printf("alignment %s; %zu of at most %zu poses associated\n", eval::AlignmentName(alignment),
               result.associated.reference.size(), result.associated.max_pairs);
   PrintStatistics(result.statistics, unit);
+  if (FLAGS_all_pairs && delta_unit == eval::DeltaUnit::kMeters &&
+      relation == eval::PoseRelation::kTranslation) {
+    std::printf("drift   %.3f %% of the distance (mean / delta)\n",
+                100.0 * result.statistics.mean / FLAGS_delta);
+  }
   if (!FLAGS_table.empty()) {
     status = WriteTable(FLAGS_table, "rpe", result.statistics, relation);
     if (!status.ok()) return Fail(status.message());
