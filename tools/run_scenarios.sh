@@ -69,7 +69,7 @@ stats() {
     END {
       if (n == 0) { printf "n/a"; exit }
       m = s / n; var = ss / n - m * m; if (var < 0) var = 0
-      if (col ~ /^nees_position/) printf "%.2f (%.2f-%.2f)", m, lo, hi
+      if (col ~ /^nees_position/ || col ~ /percent/) printf "%.2f (%.2f-%.2f)", m, lo, hi
       else if (col ~ /time/) printf "%.2f", m
       else printf "%.4f +- %.4f (%.4f-%.4f)", m, sqrt(var * n / (n > 1 ? n - 1 : 1)), lo, hi
     }' "$@"
@@ -93,7 +93,9 @@ stats() {
   echo "SE(3) alignment as mean +- sample std (min-max) [m], mean position NEES (expected 3) with"
   echo "its range, in G (no alignment) and gauge-aligned (the ground truth rotated about the first"
   echo "pose onto the estimate: the map's rotation through the LiDAR-IMU calibration error;"
-  echo "\`replay/consistency.h\`), and the mean of the per-run median per-scan time [ms]."
+  echo "\`replay/consistency.h\`), the position drift per distance as mean (min-max) [%] (mean"
+  echo "displacement error over 10 m of path from every pose, in the world frame after the SE(3)"
+  echo "alignment; docs/evaluation.md), and the mean of the per-run median per-scan time [ms]."
 } > "$DOC"
 
 for name in "${scenarios[@]}"; do
@@ -146,12 +148,14 @@ for name in "${scenarios[@]}"; do
     echo
     if [[ ${#notes[@]} -gt 0 ]]; then printf -- '- %s\n' "${notes[@]}"; fi
     if [[ ${#swarm_csvs[@]} -eq 0 ]]; then echo "(no results)"; continue; fi
-    echo "| drone | APE swarm [m] | APE single-agent [m] | NEES in G swarm | NEES in G single | NEES gauge-aligned swarm | NEES gauge-aligned single | time swarm / single [ms] |"
-    echo "|---|---|---|---|---|---|---|---|"
+    echo "| drone | APE swarm [m] | APE single-agent [m] | drift swarm / single [%] | NEES in G swarm | NEES in G single | NEES gauge-aligned swarm | NEES gauge-aligned single | time swarm / single [ms] |"
+    echo "|---|---|---|---|---|---|---|---|---|"
     for drone in $(awk -F, 'NR > 1 { print $1 }' "${swarm_csvs[0]}"); do
-      printf '| %s | %s | %s | %s | %s | %s | %s | %s / %s |\n' "$drone" \
+      printf '| %s | %s | %s | %s / %s | %s | %s | %s | %s | %s / %s |\n' "$drone" \
         "$(stats ape_rmse_m "$drone" "${swarm_csvs[@]}")" \
         "$(stats ape_rmse_m "$drone" "${single_csvs[@]}")" \
+        "$(stats drift_percent "$drone" "${swarm_csvs[@]}")" \
+        "$(stats drift_percent "$drone" "${single_csvs[@]}")" \
         "$(stats nees_position "$drone" "${swarm_csvs[@]}")" \
         "$(stats nees_position "$drone" "${single_csvs[@]}")" \
         "$(stats nees_position_aligned "$drone" "${swarm_csvs[@]}")" \

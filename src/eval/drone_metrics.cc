@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <limits>
+#include <string>
 
 namespace swarmlio::eval {
 
@@ -48,6 +49,28 @@ Status EvaluateDrone(const std::string& drone,
   } else {
     return rpe_status.WithContext(drone);
   }
+
+  if (!(options.drift_delta_m > 0.0)) {
+    return Status::InvalidArgument(drone + ": drift_delta_m must be > 0, got " +
+                                   std::to_string(options.drift_delta_m));
+  }
+  RpeOptions drift_options;
+  drift_options.delta = options.drift_delta_m;
+  drift_options.delta_unit = DeltaUnit::kMeters;
+  drift_options.all_pairs = true;
+  drift_options.alignment = Alignment::kSe3;
+  drift_options.translation_in_world = true;
+  drift_options.association = options.association;
+  RpeResult drift_result;
+  const Status drift_status = ComputeRpe(reference, estimate, drift_options, &drift_result);
+  if (drift_status.ok()) {
+    out.has_drift = true;
+    out.drift_translation = drift_result.statistics;
+  } else if (drift_status.code() == Status::Code::kFailedPrecondition) {
+    out.drift_note = drift_status.message();
+  } else {
+    return drift_status.WithContext(drone);
+  }
   *metrics = std::move(out);
   if (ape != nullptr) *ape = std::move(ape_result);
   return Status::Ok();
@@ -59,6 +82,8 @@ Status MakeDroneMetricsTable(const std::vector<DroneMetrics>& drones,
                              MetricsTable* table) {
   const std::string ape_suffix = std::string(" [m] (") + AlignmentName(options.ape_alignment) + ")";
   const std::string rpe_suffix = " [m] (delta " + DeltaText(options) + ")";
+  char drift_text[64];
+  std::snprintf(drift_text, sizeof(drift_text), "%g m", options.drift_delta_m);
   MetricsTable out;
   const std::vector<MetricsColumn> columns = {
       {"drone", "drone", 0},
@@ -71,6 +96,8 @@ Status MakeDroneMetricsTable(const std::vector<DroneMetrics>& drones,
       {"rpe_pairs", "RPE pairs", 0},
       {"rpe_rmse_m", "RPE rmse" + rpe_suffix, 4},
       {"rpe_mean_m", "RPE mean" + rpe_suffix, 4},
+      {"drift_pairs", "drift pairs", 0},
+      {"drift_percent", std::string("drift [%] (") + drift_text + " segments, W, SE(3))", 3},
   };
   for (const MetricsColumn& column : columns) SWARMLIO_RETURN_IF_ERROR(out.AddColumn(column));
   for (const MetricsColumn& column : extra_columns) {
@@ -90,6 +117,9 @@ Status MakeDroneMetricsTable(const std::vector<DroneMetrics>& drones,
         {"rpe_pairs", d.has_rpe ? static_cast<double>(r.count) : 0.0},
         {"rpe_rmse_m", d.has_rpe ? r.rmse : kMissing},
         {"rpe_mean_m", d.has_rpe ? r.mean : kMissing},
+        {"drift_pairs", d.has_drift ? static_cast<double>(d.drift_translation.count) : 0.0},
+        {"drift_percent",
+         d.has_drift ? 100.0 * d.drift_translation.mean / options.drift_delta_m : kMissing},
     };
     for (const auto& [key, value] : d.extra) {
       bool known = false;
