@@ -25,6 +25,10 @@ Status EvaluateDrone(const std::string& drone,
                      const DroneMetricsOptions& options,
                      DroneMetrics* metrics,
                      ApeResult* ape) {
+  if (!(options.drift_delta_m > 0.0)) {
+    return Status::InvalidArgument(drone + ": drift_delta_m must be > 0, got " +
+                                   std::to_string(options.drift_delta_m));
+  }
   DroneMetrics out;
   out.drone = drone;
   ApeOptions ape_options;
@@ -50,10 +54,6 @@ Status EvaluateDrone(const std::string& drone,
     return rpe_status.WithContext(drone);
   }
 
-  if (!(options.drift_delta_m > 0.0)) {
-    return Status::InvalidArgument(drone + ": drift_delta_m must be > 0, got " +
-                                   std::to_string(options.drift_delta_m));
-  }
   RpeOptions drift_options;
   drift_options.delta = options.drift_delta_m;
   drift_options.delta_unit = DeltaUnit::kMeters;
