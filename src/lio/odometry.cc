@@ -78,11 +78,6 @@ std::vector<Eigen::Vector3d> Odometry::MapPoints() const { return impl_->map.Poi
 size_t Odometry::map_size() const { return impl_->map.size(); }
 size_t Odometry::MapMemoryBytes() const { return impl_->map.MemoryBytes(); }
 
-void Odometry::PopOutputs(std::vector<ScanOutput>* outputs) {
-  for (ScanOutput& o : impl_->outputs) outputs->push_back(std::move(o));
-  impl_->outputs.clear();
-}
-
 Status Odometry::AddImu(const ImuSample& raw) {
   ++counters_.imu_samples;
   ImuSample sample = raw;
@@ -132,7 +127,7 @@ Status Odometry::AddImu(const ImuSample& raw) {
   }
   impl_->imu_queue.push_back(sample);
   if (impl_->probe.active) impl_->probe.imu.push_back(sample);
-  return ProcessReadyScans(/*flush=*/false);
+  return Status::Ok();
 }
 
 Status Odometry::AddScan(const LidarScan& scan) {
@@ -164,16 +159,16 @@ Status Odometry::AddScan(const LidarScan& scan) {
   }
   impl_->scan_queue.push_back({scan, end_ns});
   if (impl_->probe.active) impl_->probe.scans.push_back({scan, end_ns});
-  Status status;
   if (static_cast<int>(impl_->scan_queue.size()) > options_.max_queued_scans) {
     ++counters_.scans_dropped_queue;
-    status = Status::OutOfRange("no IMU data for " + std::to_string(options_.max_queued_scans) +
-                                " scans: dropped the scan at " +
-                                std::to_string(impl_->scan_queue.front().scan.stamp_ns) + " ns");
+    const Status status = Status::OutOfRange(
+        "no IMU data for " + std::to_string(options_.max_queued_scans) +
+        " scans: dropped the scan at " + std::to_string(impl_->scan_queue.front().scan.stamp_ns) +
+        " ns");
     impl_->scan_queue.pop_front();
+    return status;
   }
-  const Status processed = ProcessReadyScans(/*flush=*/false);
-  return status.ok() ? processed : status;
+  return Status::Ok();
 }
 
 void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
@@ -202,8 +197,7 @@ void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
   im.map.Insert(points_in_G, &ranges);
 }
 
-Status Odometry::Flush() {
-  const Status status = ProcessReadyScans(/*flush=*/true);
+void Odometry::FinishLog() {
   if (impl_->seed_pending) SeedMapFromStaticStart(impl_->seed_window_start_ns);
   if (impl_->window != nullptr) {
     // The scans still in the window enter the map at their current estimates.
@@ -214,7 +208,6 @@ Status Odometry::Flush() {
                  options_.insert_matched_points ? nullptr : &s.matched);
     }
   }
-  return status;
 }
 
 int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const EgoState& x,
@@ -256,51 +249,116 @@ int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const 
   return num_excluded;
 }
 
-Status Odometry::ProcessReadyScans(bool flush) {
+Status Odometry::ProcessReadyScans(bool flush, std::vector<ScanOutput>* outputs) {
   Status first_error;
-  while (!impl_->scan_queue.empty()) {
-    const PendingScan& next = impl_->scan_queue.front();
-    const bool imu_covers = impl_->have_imu && impl_->last_imu_stamp_ns >= next.end_ns;
-    if (!imu_covers && !flush) break;
-    if (impl_->seed_pending) SeedMapFromStaticStart(impl_->seed_window_start_ns);
-    PendingScan pending = std::move(impl_->scan_queue.front());
-    impl_->scan_queue.pop_front();
-    const Status status = ProcessScan(pending.scan, pending.end_ns, flush);
-    if (!status.ok() && first_error.ok()) first_error = status;
-    const internal::InFlightProbe& probe = impl_->probe;
-    if (probe.active &&
-        pending.end_ns - probe.start.stamp_ns >=
-            static_cast<int64_t>(std::llround(options_.in_flight.probe_duration_s * 1e9))) {
-      FinishInFlightPass();  // restarts from t0 (queues refilled) or abandons
+  ScanContext& scan = impl_->probe_scan;
+  while (NextScan(flush, &scan)) {
+    Status status = scan.status;
+    if (scan.predicted) {
+      Update(UpdateRequest(), &scan);
+      outputs->emplace_back();
+      status = Commit(&scan, &outputs->back());
     }
+    if (!status.ok() && first_error.ok()) first_error = status;
   }
+  if (flush) FinishLog();
   return first_error;
 }
 
-Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) {
+bool Odometry::NextScan(bool flush, ScanContext* scan) {
   Impl& im = *impl_;
-  const Clock::time_point t_start = Clock::now();
+  while (!im.scan_queue.empty()) {
+    const PendingScan& next = im.scan_queue.front();
+    const bool imu_covers = im.have_imu && im.last_imu_stamp_ns >= next.end_ns;
+    if (!imu_covers && !flush) return false;
+    if (im.seed_pending) SeedMapFromStaticStart(im.seed_window_start_ns);
+    PendingScan pending = std::move(im.scan_queue.front());
+    im.scan_queue.pop_front();
+    scan->raw = std::move(pending.scan);
+    scan->end_ns = pending.end_ns;
+    scan->flush = flush;
+    Predict(scan);
+    if (!im.probe.active) return true;
+    // An in-flight pass: no front end, no output.
+    ProcessProbeScan(scan);
+    const bool pass_over =
+        im.probe.active &&
+        scan->end_ns - im.probe.start.stamp_ns >=
+            static_cast<int64_t>(std::llround(options_.in_flight.probe_duration_s * 1e9));
+    if (pass_over) FinishInFlightPass();  // restarts from t0 (queues refilled) or abandons
+    if (!scan->status.ok()) {
+      scan->predicted = false;  // the error reaches the caller; the scan is done
+      return true;
+    }
+  }
+  return false;
+}
+
+void Odometry::ProcessProbeScan(ScanContext* scan) {
+  if (!scan->predicted) return;
+  Update(UpdateRequest(), scan);
   ScanOutput out;
-  out.scan_stamp_ns = scan.stamp_ns;
+  scan->status = Commit(scan, &out);
+  if (out.updated) {
+    impl_->probe.positions.push_back({out.stamp_ns, out.state.p_b_in_G, out.state.q_G_b});
+    impl_->probe.gyro_bias = out.state.gyro_bias;
+  }
+}
+
+void Odometry::Predict(ScanContext* scan) {
+  Impl& im = *impl_;
+  scan->started = Clock::now();
+  scan->predicted = false;
+  scan->status = Status::Ok();
+  scan->excluded.clear();
+  ScanOutput& out = scan->out;
+  out = ScanOutput();
+  out.scan_stamp_ns = scan->raw.stamp_ns;
+  const int64_t end_ns = scan->end_ns;
   // In flight, the odometry proper starts at started_ns (the newest input when
   // the last pass ended); at rest started_ns is the initialization's stamp.
   out.held_by_initialization = im.initialization.started_ns > im.initialization.stamp_ns &&
                                end_ns <= im.initialization.started_ns;
-  out.num_raw_points = static_cast<int>(scan.points.size());
+  out.num_raw_points = static_cast<int>(scan->raw.points.size());
 
   // 1. Preprocess.
   Clock::time_point t = Clock::now();
-  im.preprocess->Run(scan, &im.points_in_b);
+  im.preprocess->Run(scan->raw, &im.points_in_b);
   out.num_points = static_cast<int>(im.points_in_b.size());
   out.timings.preprocess_s = SecondsSince(t);
 
   // 2. Propagate over the scan's IMU samples to its end.
   t = Clock::now();
+  if (!Propagate(scan)) return;
+  out.timings.propagate_s = SecondsSince(t);
+
+  // 3. Motion compensation to the scan end.
+  t = Clock::now();
+  const ImuPropagator& prop = *im.propagator;
+  if (Status status = UndistortPoints(im.points_in_b, scan->raw.stamp_ns, prop.scan_poses(),
+                                      &im.undistorted);
+      !status.ok()) {
+    scan->status = status;
+    return;
+  }
+  out.timings.undistort_s = SecondsSince(t);
+  scan->stamp_ns = prop.stamp_ns();
+  scan->poses = &prop.scan_poses();
+  scan->previous_scan_degenerate = im.previous_degenerate;
+  scan->x = prop.state();
+  scan->P = prop.covariance();
+  scan->predicted = true;
+}
+
+bool Odometry::Propagate(ScanContext* scan) {
+  Impl& im = *impl_;
+  const int64_t end_ns = scan->end_ns;
   ImuPropagator& prop = *im.propagator;
   if (end_ns < prop.stamp_ns()) {
     ++counters_.scans_out_of_order;
-    return Status::InvalidArgument("scan ending at " + std::to_string(end_ns) +
-                                   " ns ends before the current state time; dropped");
+    scan->status = Status::InvalidArgument("scan ending at " + std::to_string(end_ns) +
+                                           " ns ends before the current state time; dropped");
+    return false;
   }
   prop.StartScan();
   if (im.window != nullptr) {
@@ -308,7 +366,6 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
     im.window->StartInterval(prop.stamp_ns(), prop.last_sample(),
                              im.initialization.acceleration_to_m_s2, prop.state().ego);
   }
-  Status first_error;
   while (!im.imu_queue.empty() && im.imu_queue.front().stamp_ns <= end_ns) {
     const ImuSample sample = im.imu_queue.front();
     im.imu_queue.pop_front();
@@ -319,141 +376,121 @@ Status Odometry::ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush) 
       ++counters_.imu_gaps;
       const SwarmState x = prop.state();
       const Eigen::MatrixXd P = prop.covariance();
-      SWARMLIO_RETURN_IF_ERROR(prop.Reset(x, P, sample, im.initialization.acceleration_to_m_s2));
-      if (first_error.ok()) first_error = status;
-    } else if (!status.ok() && first_error.ok()) {
-      first_error = status;
+      if (Status reset = prop.Reset(x, P, sample, im.initialization.acceleration_to_m_s2);
+          !reset.ok()) {
+        scan->status = reset;
+        return false;
+      }
+      if (scan->status.ok()) scan->status = status;
+    } else if (!status.ok() && scan->status.ok()) {
+      scan->status = status;
     }
   }
   const ImuSample* next = im.imu_queue.empty() ? nullptr : &im.imu_queue.front();
   if (im.window != nullptr) im.window->IntegrateTo(end_ns, next);
   if (Status status = prop.PropagateTo(end_ns, next); !status.ok()) {
-    if (!flush || status.code() != Status::Code::kOutOfRange) return status;
     // Flushing past the end of the IMU data: hold the state at its last time.
-  }
-  out.timings.propagate_s = SecondsSince(t);
-
-  // 3. Motion compensation to the scan end.
-  t = Clock::now();
-  SWARMLIO_RETURN_IF_ERROR(UndistortPoints(im.points_in_b, scan.stamp_ns, prop.scan_poses(),
-                                           &im.undistorted));
-  out.timings.undistort_s = SecondsSince(t);
-
-  // 3b. Front end of the hooks (may change the state's teammate blocks).
-  // An in-flight probe pass runs without them (its states are provisional).
-  ScanStageHooks* hooks = im.probe.active ? nullptr : hooks_;
-  SwarmState x = prop.state();
-  Eigen::MatrixXd P = prop.covariance();
-  UpdateRequest request;
-  if (hooks != nullptr) {
-    t = Clock::now();
-    FrontEndScan front;
-    front.raw = &scan;
-    front.end_stamp_ns = prop.stamp_ns();
-    front.poses = &prop.scan_poses();
-    front.previous_scan_degenerate = im.previous_degenerate;
-    const Status status = hooks->OnFrontEnd(front, &x, &P, &request);
-    if (!status.ok()) {
-      out.hook_error = status.message();
-      request = UpdateRequest();
+    if (!scan->flush || status.code() != Status::Code::kOutOfRange) {
+      scan->status = status;
+      return false;
     }
-    if (x.layout() != prop.state().layout()) prop.SetState(x, P);
-    out.timings.front_end_s = SecondsSince(t);
   }
+  return true;
+}
 
-  // 4. Update, 4b + 5. map.
+void Odometry::Update(const UpdateRequest& request, ScanContext* scan) {
+  Impl& im = *impl_;
+  // The front end may have changed the teammate blocks.
+  if (scan->x.layout() != im.propagator->state().layout()) im.propagator->SetState(scan->x, scan->P);
   if (im.window != nullptr) {
-    UpdateWithWindow(request, &x, &P, &out);
+    UpdateWithWindow(request, scan);
   } else {
-    UpdateWithFilter(request, &x, &P, &out);
+    UpdateWithFilter(request, scan);
+  }
+}
+
+Status Odometry::Commit(ScanContext* scan, ScanOutput* output) {
+  Impl& im = *impl_;
+  ScanOutput& out = scan->out;
+  if (im.window == nullptr) {
+    // 5. Map: register with the (posterior) state and insert, except the
+    // points in the excluded regions (teammates). Only updated scans and the
+    // very first one grow the map, so a failed update cannot write a
+    // misregistered scan into it.
+    const Clock::time_point t = Clock::now();
+    if (out.updated || im.map_was_empty) {
+      // Without insert_matched_points, the points the update matched to a map
+      // plane stay out of the map (the map explains them already).
+      const std::vector<int>* matched = options_.insert_matched_points || !out.updated
+                                            ? nullptr
+                                            : &im.associator.matched_point_indices();
+      out.num_excluded_points =
+          InsertScan(im.undistorted, scan->x.ego, scan->excluded,
+                     options_.output_registered_scan ? &out.registered_in_G : nullptr, matched);
+    }
+    out.timings.map_update_s = SecondsSince(t);
   }
   out.map_size = im.map.size();
-
-  out.stamp_ns = prop.stamp_ns();
-  out.state = x.ego;
-  out.covariance = P.topLeftCorner<ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>();
-  out.timings.total_s = SecondsSince(t_start);
-  im.last_scan_end_ns = end_ns;
+  out.stamp_ns = im.propagator->stamp_ns();
+  out.state = scan->x.ego;
+  out.covariance = scan->P.topLeftCorner<ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>();
+  out.timings.total_s = SecondsSince(scan->started);
+  im.last_scan_end_ns = scan->end_ns;
   im.have_scan = true;
   ++counters_.scans_processed;
-  if (im.probe.active) {
-    if (out.updated) {
-      im.probe.positions.push_back({out.stamp_ns, out.state.p_b_in_G, out.state.q_G_b});
-      im.probe.gyro_bias = out.state.gyro_bias;
-    }
-    return first_error;
-  }
-  if (hooks != nullptr) hooks->OnScanDone(out, x, P);
-  im.outputs.push_back(std::move(out));
-  return first_error;
+  *output = std::move(out);
+  return scan->status;
 }
 
-void Odometry::UpdateWithFilter(const UpdateRequest& request, SwarmState* x_io,
-                                Eigen::MatrixXd* P_io, ScanOutput* out) {
+void Odometry::UpdateWithFilter(const UpdateRequest& request, ScanContext* scan) {
   Impl& im = *impl_;
-  SwarmState& x = *x_io;
-  Eigen::MatrixXd& P = *P_io;
+  SwarmState& x = scan->x;
+  Eigen::MatrixXd& P = scan->P;
+  ScanOutput* out = &scan->out;
   ImuPropagator& prop = *im.propagator;
   const bool map_ready = !im.map.empty();
+  im.map_was_empty = !map_ready;
   const bool enough_points = static_cast<int>(im.undistorted.size()) >= options_.min_scan_points;
-  if (map_ready && enough_points) {
-    im.associator.Reset(&im.undistorted);
-    PlaneMeasurementModel planes(
-        [&](const SwarmState& at, std::vector<PlaneCorrespondence>* correspondences) {
-          return im.associator.Associate(at, correspondences);
-        });
-    std::vector<MeasurementModel*> models{&planes};
-    models.insert(models.end(), request.models.begin(), request.models.end());
-    const bool subset = hooks_ != nullptr && !im.probe.active;
-    const EsikfUpdateResult result =
-        im.update.Run(x, P, models, subset ? &request.estimated_teammates : nullptr,
-                      subset ? &request.considered_teammates : nullptr);
-    out->timings.association_s = result.association_time_s;
-    out->timings.solve_s = result.solve_time_s;
-    out->timings.covariance_s = result.covariance_time_s;
-    out->iterations = result.iterations;
-    out->converged = result.converged;
-    out->num_correspondences = static_cast<int>(planes.correspondences().size());
-    out->num_measurement_blocks = result.num_residual_blocks;
-    out->min_normal_information = im.associator.stats().MinNormalInformation();
-    out->degenerate = out->min_normal_information < options_.association.degeneracy_threshold;
-    if (result.status.ok() && IsFinite(result.state, result.covariance)) {
-      x = result.state;
-      P = result.covariance;
-      out->updated = true;
-      ++counters_.scans_updated;
-      if (out->degenerate) ++counters_.scans_degenerate;
-      im.previous_degenerate = out->degenerate;
-      prop.SetState(x, P);
-    } else {
-      ++counters_.updates_failed;
-      out->update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
-    }
+  if (!map_ready || !enough_points) return;
+  im.associator.Reset(&im.undistorted);
+  PlaneMeasurementModel planes(
+      [&](const SwarmState& at, std::vector<PlaneCorrespondence>* correspondences) {
+        return im.associator.Associate(at, correspondences);
+      });
+  std::vector<MeasurementModel*> models{&planes};
+  models.insert(models.end(), request.models.begin(), request.models.end());
+  const bool subset = request.select_teammates;
+  const EsikfUpdateResult result =
+      im.update.Run(x, P, models, subset ? &request.estimated_teammates : nullptr,
+                    subset ? &request.considered_teammates : nullptr);
+  out->timings.association_s = result.association_time_s;
+  out->timings.solve_s = result.solve_time_s;
+  out->timings.covariance_s = result.covariance_time_s;
+  out->iterations = result.iterations;
+  out->converged = result.converged;
+  out->num_correspondences = static_cast<int>(planes.correspondences().size());
+  out->num_measurement_blocks = result.num_residual_blocks;
+  out->min_normal_information = im.associator.stats().MinNormalInformation();
+  out->degenerate = out->min_normal_information < options_.association.degeneracy_threshold;
+  if (result.status.ok() && IsFinite(result.state, result.covariance)) {
+    x = result.state;
+    P = result.covariance;
+    out->updated = true;
+    ++counters_.scans_updated;
+    if (out->degenerate) ++counters_.scans_degenerate;
+    im.previous_degenerate = out->degenerate;
+    prop.SetState(x, P);
+  } else {
+    ++counters_.updates_failed;
+    out->update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
   }
-
-  // 4b + 5. Map: register with the (posterior) state and insert, except the
-  // points in the excluded regions (teammates). Only updated scans and the
-  // very first one grow the map, so a failed update cannot write a
-  // misregistered scan into it.
-  const Clock::time_point t = Clock::now();
-  if (out->updated || !map_ready) {
-    // Without insert_matched_points, the points the update matched to a map
-    // plane stay out of the map (the map explains them already).
-    const std::vector<int>* matched =
-        options_.insert_matched_points || !out->updated ? nullptr
-                                                         : &im.associator.matched_point_indices();
-    out->num_excluded_points = InsertScan(
-        im.undistorted, x.ego, request.excluded,
-        options_.output_registered_scan ? &out->registered_in_G : nullptr, matched);
-  }
-  out->timings.map_update_s = SecondsSince(t);
 }
 
-void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
-                                Eigen::MatrixXd* P_io, ScanOutput* out) {
+void Odometry::UpdateWithWindow(const UpdateRequest& request, ScanContext* scan) {
   Impl& im = *impl_;
-  SwarmState& x = *x_io;
-  Eigen::MatrixXd& P = *P_io;
+  SwarmState& x = scan->x;
+  Eigen::MatrixXd& P = scan->P;
+  ScanOutput* out = &scan->out;
   ImuPropagator& prop = *im.propagator;
   const bool enough_points = static_cast<int>(im.undistorted.size()) >= options_.min_scan_points;
 
@@ -464,7 +501,7 @@ void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
   input.P_pred = P;
   input.points_in_b = im.undistorted;
   input.use_planes = enough_points;
-  input.excluded = request.excluded;
+  input.excluded = scan->excluded;
   input.models = request.models;
   input.considered_teammates = request.considered_teammates;
   std::vector<internal::LeavingScan> leaving;
@@ -472,7 +509,7 @@ void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
   const Status added = im.window->AddState(std::move(input), &leaving, &out->timings.marginalize_s,
                                            &model_error);
   if (!model_error.empty()) {
-    out->hook_error += (out->hook_error.empty() ? "" : "; ") + model_error;
+    out->front_end_error += (out->front_end_error.empty() ? "" : "; ") + model_error;
   }
 
   // Map: the scans that left, at their final estimates (only scans that a
@@ -486,7 +523,7 @@ void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
     }
   }
   if (im.map.empty()) {
-    out->num_excluded_points = InsertScan(im.undistorted, x.ego, request.excluded, nullptr);
+    out->num_excluded_points = InsertScan(im.undistorted, x.ego, scan->excluded, nullptr);
     if (added.ok()) im.window->MarkNewestInMap();
   }
   out->timings.map_update_s = SecondsSince(t);
@@ -496,7 +533,22 @@ void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
     return;
   }
 
-  const internal::WindowSolveResult result = im.window->Solve();
+  TakeWindowSolution(im.window->Solve(), enough_points, scan);
+  if (options_.output_registered_scan) {
+    const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
+    for (const Eigen::Vector3d& p : im.undistorted) {
+      out->registered_in_G.push_back(R_G_b * p + x.ego.p_b_in_G);
+    }
+  }
+}
+
+void Odometry::TakeWindowSolution(const internal::WindowSolveResult& result, bool enough_points,
+                                  ScanContext* scan) {
+  Impl& im = *impl_;
+  ScanOutput* out = &scan->out;
+  SwarmState& x = scan->x;
+  Eigen::MatrixXd& P = scan->P;
+  ImuPropagator& prop = *im.propagator;
   out->timings.build_s = result.build_s;
   out->timings.association_s = result.association_s;
   out->timings.solve_s = result.solve_s;
@@ -525,12 +577,6 @@ void Odometry::UpdateWithWindow(const UpdateRequest& request, SwarmState* x_io,
   } else if (enough_points) {
     ++counters_.updates_failed;
     out->update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
-  }
-  if (options_.output_registered_scan) {
-    const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
-    for (const Eigen::Vector3d& p : im.undistorted) {
-      out->registered_in_G.push_back(R_G_b * p + x.ego.p_b_in_G);
-    }
   }
 }
 

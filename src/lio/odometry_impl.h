@@ -27,7 +27,7 @@ struct PendingScan {
 
 // An in-flight initialization in progress (docs/imu.md section 1b): the data
 // since the start t0 are kept, and each pass runs the odometry over them
-// without the hooks and without outputs; its scan positions fit v0 and g.
+// without a front end and without outputs; its scan positions fit v0 and g.
 struct InFlightProbe {
   bool active = false;
   int pass = 0;                                         // passes finished
@@ -62,12 +62,13 @@ struct Odometry::Impl {
   bool seed_pending = false;
   int64_t seed_window_start_ns = 0;
   internal::InFlightProbe probe;
-  std::vector<ScanOutput> outputs;
   int64_t last_imu_stamp_ns = 0;
   bool have_imu = false;
   int64_t last_scan_end_ns = 0;
   bool have_scan = false;
   bool previous_degenerate = false;  // the last updated scan's flag (front end)
+  bool map_was_empty = false;        // the filter's map before this scan's update
+  ScanContext probe_scan;            // scratch of ProcessReadyScans
   // Scratch reused between scans.
   std::vector<PointXYZT> points_in_b;
   std::vector<Eigen::Vector3d> undistorted;

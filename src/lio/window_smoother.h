@@ -32,7 +32,7 @@
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/measurement_model.h"
 #include "swarmlio/lio/scan_association.h"
-#include "swarmlio/lio/scan_stage_hooks.h"
+#include "swarmlio/lio/scan_stages.h"
 #include "swarmlio/lio/window_options.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/swarm_state.h"

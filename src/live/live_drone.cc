@@ -259,7 +259,7 @@ void LiveDrone::Impl::Collect(std::vector<swarm::DroneOutput>* outputs, bool at_
     ++stats.scans_processed;
     if (o.ego.held_by_initialization) ++stats.scans_held_by_initialization;
     if (!o.ego.update_error.empty()) Warn(Status::Internal("update failed: " + o.ego.update_error));
-    if (!o.ego.hook_error.empty()) Warn(Status::Internal("swarm front end: " + o.ego.hook_error));
+    if (!o.ego.front_end_error.empty()) Warn(Status::Internal("swarm front end: " + o.ego.front_end_error));
     imu_rate->ResetToScan(o.ego.state, o.ego.stamp_ns, AccelerationFactor());
     ScanLatency latency;
     latency.scan_end_clock_ns = mapping.ToClockNs(o.ego.stamp_ns);

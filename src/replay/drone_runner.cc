@@ -160,7 +160,7 @@ void DroneRunner::Collect() {
     scans_.push_back(ToScanRecord(o));
     for (const swarm::IdentificationEvent& e : o.identifications) identifications_.push_back(e);
     if (!o.ego.update_error.empty()) Warn(Status::Internal("update failed: " + o.ego.update_error));
-    if (!o.ego.hook_error.empty()) Warn(Status::Internal("swarm front end: " + o.ego.hook_error));
+    if (!o.ego.front_end_error.empty()) Warn(Status::Internal("swarm front end: " + o.ego.front_end_error));
   }
 }
 

@@ -44,10 +44,6 @@ struct TeammateInfo {
   // broadcasts; kTrajectoryMatch entries only: j's derived edges are never
   // composed here, j cannot tell through whom it derived them).
   std::map<int, net::GlobalExtrinsicEntry> identified;
-  // j's gravity in G_j from its newest GlobalExtrinsic message, fused once.
-  bool gravity_pending = false;
-  Eigen::Vector3d g_in_Gj = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d cov_g_in_Gj = Eigen::Matrix3d::Zero();
 };
 
 using Teammates = std::map<int, TeammateInfo>;

@@ -350,25 +350,31 @@ std::vector<lio::ScanOutput> RunOdometry(const replay::DroneInput& drone, int64_
   std::deque<LidarScan> held;
   io::BagRecord record;
   bool has = false;
+  // Each input is processed as it comes, as the component does.
+  const auto process = [&] { (void)odometry->ProcessReadyScans(/*flush=*/false, &outputs); };
   while (reader->Next(&record, &has).ok() && has) {
     if (const ImuSample* imu = record.imu()) {
       (void)odometry->AddImu(*imu);  // errors are counted; the comparison shows them
+      process();
       while (!held.empty() && held.front().stamp_ns + scan_delay_ns <= imu->stamp_ns) {
         (void)odometry->AddScan(held.front());
+        process();
         held.pop_front();
       }
     } else if (const LidarScan* scan = record.scan()) {
       held.push_back(*scan);
       if (scan_delay_ns == 0) {
         (void)odometry->AddScan(held.front());
+        process();
         held.pop_front();
       }
     }
-    odometry->PopOutputs(&outputs);
   }
-  for (const LidarScan& scan : held) (void)odometry->AddScan(scan);
-  (void)odometry->Flush();
-  odometry->PopOutputs(&outputs);
+  for (const LidarScan& scan : held) {
+    (void)odometry->AddScan(scan);
+    process();
+  }
+  (void)odometry->ProcessReadyScans(/*flush=*/true, &outputs);
   *counters = odometry->counters();
   return outputs;
 }

@@ -26,23 +26,26 @@ class OdometrySink : public sim::DroneSink {
   explicit OdometrySink(lio::Odometry* odometry) : odometry_(odometry) {}
   Status OnImu(const ImuSample& imu) override {
     // Data problems are counted by the odometry; only real errors fail the run.
-    const Status status = odometry_->AddImu(imu);
-    Collect();
+    Status status = odometry_->AddImu(imu);
+    if (status.ok()) status = Collect(/*flush=*/false);
     return status.code() == Status::Code::kInvalidArgument ? Status::Ok() : status;
   }
   Status OnScan(const LidarScan& scan, int64_t) override {
-    const Status status = odometry_->AddScan(scan);
-    Collect();
+    Status status = odometry_->AddScan(scan);
+    const Status processed = Collect(/*flush=*/false);
+    if (status.ok()) status = processed;
     return status.code() == Status::Code::kInvalidArgument ? Status::Ok() : status;
   }
   Status OnGroundTruth(const PoseStamped& pose) override {
     ground_truth.push_back(pose);
     return Status::Ok();
   }
-  void Collect() {
+  // The scans ready (every queued one with `flush`, at the end of a log).
+  Status Collect(bool flush) {
     std::vector<lio::ScanOutput> outputs;
-    odometry_->PopOutputs(&outputs);
+    const Status status = odometry_->ProcessReadyScans(flush, &outputs);
     for (const auto& o : outputs) scans.push_back(replay::ToScanRecord(o));
+    return status;
   }
 
   std::vector<replay::ScanRecord> scans;
@@ -95,8 +98,7 @@ void RunWithGivenCalibration(sim::Simulator* simulator, const sim::DroneConfig& 
   OdometrySink sink(odometry.get());
   sim::DroneStats stats;
   ASSERT_TRUE(simulator->RunDrone(index, &sink, &stats).ok());
-  ASSERT_TRUE(odometry->Flush().ok());
-  sink.Collect();
+  ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
   ASSERT_TRUE(
       replay::EvaluateConsistency(sink.scans, sink.ground_truth, 0.05, consistency).ok());
 }
@@ -124,8 +126,7 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
     OdometrySink sink(odometry.get());
     sim::DroneStats stats;
     ASSERT_TRUE(simulator.RunDrone(c.drone, &sink, &stats).ok());
-    ASSERT_TRUE(odometry->Flush().ok());
-    sink.Collect();
+    ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
 
     ASSERT_TRUE(odometry->initialized());
     ASSERT_GE(sink.scans.size(), 80u);
@@ -178,8 +179,7 @@ TEST(OdometryEndToEnd, StaticStartScansSeedTheMap) {
     OdometrySink sink(odometry.get());
     sim::DroneStats stats;
     ASSERT_TRUE(simulator.RunDrone(2, &sink, &stats).ok());
-    ASSERT_TRUE(odometry->Flush().ok());
-    sink.Collect();
+    ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
     const lio::OdometryCounters& c = odometry->counters();
     replay::ConsistencyStats consistency;
     ASSERT_TRUE(

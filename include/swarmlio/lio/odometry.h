@@ -2,32 +2,40 @@
 // ego part; FAST-LIO2's pipeline), a pure core fed with IMU samples and LiDAR
 // scans in stamp order. docs/lio.md describes the pipeline and its figures.
 //
-// Per scan [t_s, t_e] (t_e = stamp + last point time), once IMU data reach t_e:
-//   1. preprocess (filters, stride, range gate, voxel) -> points in b with times;
-//   2. propagate the state over the scan's IMU samples to t_e (eq. (2)-(3));
-//   3. undistort every point to the body frame at t_e;
-//   3b. front end of the installed ScanStageHooks (scan_stage_hooks.h):
-//      teammate detection on the full scan, extra measurement models;
-//   4. iterated update (EsikfUpdate: prior + point-to-plane on Ceres + the
-//      hooks' models), every model re-linearized at each iteration;
-//   4b. points in the hooks' excluded regions (teammates) are removed;
-//   5. insert the registered points into the local map, move the map box.
+// Inputs are queued (AddImu, AddScan); the component that owns the odometry
+// drives each scan through its stages once IMU data cover it
+// (scan_stages.h):
+//   NextScan  1. preprocess (filters, stride, range gate, voxel) -> points in
+//                b with times;
+//             2. propagate the state over the scan's IMU samples to its end
+//                t_e (eq. (2)-(3));
+//             3. undistort every point to the body frame at t_e;
+//   (the component's front end: teammate detection, extra models)
+//   Update    4. iterated update (EsikfUpdate: prior + point-to-plane on
+//                Ceres + the component's models), every model re-linearized
+//                at each iteration;
+//   Commit    5. insert the registered points but those in the excluded
+//                regions (teammates) into the local map, move the map box;
+//                the scan's output.
 // The first scan after IMU initialization only builds the map.
 // With `estimator: window` steps 4-5 are the fixed-lag window smoother's
 // (docs/window.md): the scan's state joins the window, the state that leaves
 // it is marginalized and its scan inserted into the map, then the window is
 // solved; the output is the newest state and its marginal covariance.
+// ProcessReadyScans runs the stages without a front end (a single drone).
 //
 // Before the first scan can be used the IMU must initialize from a static
 // window (ImuInitializer); scans before that are dropped and counted. With
 // `initialization: in_flight` the drone may be moving: after the IMU window,
 // LiDAR passes over the first in_flight.probe_duration_s of scans fit the
-// initial velocity and gravity (in_flight_alignment.h); initialized() turns
-// true, and outputs come, once the last pass has started the odometry.
+// initial velocity and gravity (in_flight_alignment.h); NextScan runs those
+// passes itself (no front end, no outputs); initialized() turns true, and
+// scans reach the caller, once the last pass has started the odometry.
 // Threading: none inside; one instance per drone, not thread-safe.
 #pragma once
 
 #include <Eigen/Core>
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -35,13 +43,17 @@
 #include <vector>
 
 #include "swarmlio/common/status.h"
+#include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/odometry_options.h"
-#include "swarmlio/lio/scan_stage_hooks.h"
+#include "swarmlio/lio/scan_stages.h"
 #include "swarmlio/sensors/lidar_options.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/swarm_state.h"
 
 namespace swarmlio::lio {
+namespace internal {
+struct WindowSolveResult;
+}  // namespace internal
 
 /// Wall time of each stage of one scan [s].
 struct ScanTimings {
@@ -51,7 +63,7 @@ struct ScanTimings {
   double association_s = 0.0;  // kNN + plane fits, all iterations (window: all its scans)
   double solve_s = 0.0;        // ceres::Solve, all iterations
   double covariance_s = 0.0;   // posterior covariance (window: the newest state's marginal)
-  double front_end_s = 0.0;    // the hooks' front end (teammate detection, models)
+  double front_end_s = 0.0;    // the component's front end (teammate detection, models)
   double map_update_s = 0.0;   // registration into G + map insertion + box move
   // The window back end only (0 with the filter; docs/window.md):
   double build_s = 0.0;        // IMU re-integration + problem construction
@@ -76,7 +88,7 @@ struct ScanOutput {
   int num_correspondences = 0;    // at the last iteration
   int num_measurement_blocks = 0; // residual blocks of all models at the last iteration
   int num_excluded_points = 0;    // kept out of the map (teammates)
-  std::string hook_error;         // the hooks' front-end error ("" otherwise)
+  std::string front_end_error;    // the component's front-end or models' error ("" otherwise)
   int iterations = 0;
   bool converged = false;
   /// Smallest eigenvalue of sum n n^T over the last correspondences, and
@@ -86,6 +98,32 @@ struct ScanOutput {
   size_t map_size = 0;            // map points after the insertion
   ScanTimings timings;
   std::vector<Eigen::Vector3d> registered_in_G;  // when output_registered_scan
+};
+
+/// One scan between the stages (NextScan -> the caller's front end ->
+/// Update -> Commit). Reused from scan to scan.
+struct ScanContext {
+  LidarScan raw;            // as received (LiDAR frame), reflectivity kept
+  int64_t end_ns = 0;       // its last point's time
+  int64_t stamp_ns = 0;     // the state's time: end_ns, or the last IMU time when flushing past it
+  bool flush = false;       // taken at the end of a log (IMU may not cover it)
+  /// Steps 1-3 succeeded; false: `status` says why and the scan is dropped.
+  bool predicted = false;
+  /// The scan's first error (an IMU gap, a propagation error); the scan is
+  /// still processed when `predicted`.
+  Status status;
+  /// The propagated poses over the scan (undistortion); valid until the
+  /// next NextScan.
+  const std::vector<ImuPose>* poses = nullptr;
+  bool previous_scan_degenerate = false;  // the last updated scan's degeneracy flag
+  /// The prediction at the scan end; the front end may add or remove
+  /// teammate blocks (layout and covariance together). After Update: the
+  /// posterior (or the prediction when not updated).
+  SwarmState x;
+  Eigen::MatrixXd P;
+  std::vector<ExcludedRegion> excluded;  // set by the front end before Update
+  ScanOutput out;                        // filled by the stages
+  std::chrono::steady_clock::time_point started;  // for timings.total_s
 };
 
 /// Counters of everything the odometry skipped or dropped.
@@ -119,24 +157,37 @@ class Odometry {
                        std::unique_ptr<Odometry>* odometry);
   ~Odometry();
 
-  /// Feeds one IMU sample (raw units; the initializer finds the unit).
+  /// Queues one IMU sample (raw units; the initializer finds the unit).
   /// Non-finite or out-of-order samples are dropped and counted: the
-  /// returned Status says so (InvalidArgument), nothing else changes. May
-  /// process queued scans (outputs via PopOutputs()); an error of that
-  /// processing is returned too (the scan is counted and skipped).
+  /// returned Status says so (InvalidArgument), nothing else changes.
   Status AddImu(const ImuSample& sample);
 
-  /// Queues a scan; it is processed once IMU data cover its end. Returns a
-  /// non-ok Status when the scan is dropped (empty, out of order, queue full).
+  /// Queues a scan; NextScan hands it out once IMU data cover its end.
+  /// Returns a non-ok Status when a scan is dropped (empty, out of order,
+  /// queue full).
   Status AddScan(const LidarScan& scan);
 
-  /// Processes every queued scan with the IMU data at hand (the last input
-  /// held up to the scan end): call at the end of a log.
-  Status Flush();
+  /// Steps 1-3 of the next scan whose end the IMU data cover (with `flush`:
+  /// the next queued scan, the last input held up to its end). False when no
+  /// scan is ready. True: `scan` holds it; when scan->predicted the caller
+  /// runs its front end, then Update and Commit; otherwise scan->status says
+  /// why it was dropped. Runs the in-flight initialization's passes itself.
+  bool NextScan(bool flush, ScanContext* scan);
 
-  /// Moves the outputs of the scans processed so far into `*outputs`
-  /// (appended) and forgets them.
-  void PopOutputs(std::vector<ScanOutput>* outputs);
+  /// Step 4 with the request's models (filter or window back end).
+  void Update(const UpdateRequest& request, ScanContext* scan);
+
+  /// Step 5 and the scan's output (moved into *output). Returns scan->status.
+  Status Commit(ScanContext* scan, ScanOutput* output);
+
+  /// The end of a log, after the last NextScan(flush = true): a pending map
+  /// seed is made, and the scans still in the window enter the map.
+  void FinishLog();
+
+  /// A single drone without a front end: every ready scan through the stages
+  /// (outputs appended); with `flush`, every queued scan and FinishLog().
+  /// Returns the first error of a scan (the scan is counted and skipped).
+  Status ProcessReadyScans(bool flush, std::vector<ScanOutput>* outputs);
 
   bool initialized() const;
   /// Why the IMU has not initialized yet ("" once it has).
@@ -153,9 +204,6 @@ class Odometry {
   size_t map_size() const;
   size_t MapMemoryBytes() const;
 
-  /// Installs the scan-stage hooks (not owned; nullptr removes them).
-  void SetHooks(ScanStageHooks* hooks) { hooks_ = hooks; }
-
   const OdometryCounters& counters() const { return counters_; }
   const OdometryOptions& options() const { return options_; }
 
@@ -163,7 +211,6 @@ class Odometry {
   struct Impl;
   Odometry(const OdometryOptions& options, const LidarOptions& lidar);
 
-  Status ProcessReadyScans(bool flush);
   void SeedMapFromStaticStart(int64_t window_start_ns);
   // In-flight initialization (odometry_in_flight.cc, docs/imu.md section 1b).
   void StartInFlightProbe(const ImuInitialization& coarse);
@@ -173,13 +220,22 @@ class Odometry {
   // Map, window and propagator back to `start` at t0; the buffered IMU
   // samples and scans queued again.
   Status RestartFromInFlightStart(const ImuInitialization& start);
-  Status ProcessScan(const LidarScan& scan, int64_t end_ns, bool flush);
-  // Steps 4-5 of ProcessScan with each back end: x, P in = the prediction,
-  // out = the posterior (or the prediction when not updated).
-  void UpdateWithFilter(const UpdateRequest& request, SwarmState* x, Eigen::MatrixXd* P,
-                        ScanOutput* out);
-  void UpdateWithWindow(const UpdateRequest& request, SwarmState* x, Eigen::MatrixXd* P,
-                        ScanOutput* out);
+  // Steps 1-3 of scan->raw (NextScan).
+  void Predict(ScanContext* scan);
+  // Step 2: the state over the scan's IMU samples to its end; false (and
+  // scan->status) when the scan cannot be used.
+  bool Propagate(ScanContext* scan);
+  // A scan of an in-flight probe pass: the stages without front end and
+  // output; its position feeds the pass's fit.
+  void ProcessProbeScan(ScanContext* scan);
+  // Step 4 with each back end: scan->x, P in = the prediction, out = the
+  // posterior (or the prediction when not updated). The filter's map
+  // insertion is Commit's; the window inserts the scans that leave it here.
+  void UpdateWithFilter(const UpdateRequest& request, ScanContext* scan);
+  void UpdateWithWindow(const UpdateRequest& request, ScanContext* scan);
+  // The window's solution into the scan's state and output.
+  void TakeWindowSolution(const internal::WindowSolveResult& result, bool enough_points,
+                          ScanContext* scan);
   // Registers the points with x, inserts all but the excluded ones and those
   // listed in skip_indices into the map (moving its box to x) and returns how
   // many were excluded. registered_in_G (cleared) gets every point not
@@ -193,7 +249,6 @@ class Odometry {
   LidarOptions lidar_;
   std::unique_ptr<Impl> impl_;
   OdometryCounters counters_;
-  ScanStageHooks* hooks_ = nullptr;
   std::string init_error_ = "no IMU data yet";
 };
 

@@ -1,19 +1,21 @@
 // swarm::DroneEstimator: everything one drone runs (paper Fig. 2), the
 // component the offline replay, the live process, the ROS node and the tests
-// drive. It owns the LiDAR-inertial odometry (lio::Odometry), the teammate
-// detector / trackers / identification (teammate::TeammateDetector) and the
-// swarm state (T_Gi_Gj blocks in the odometry's state), and takes part in
-// the odometry's scan pipeline through lio::ScanStageHooks:
+// drive. A manager over collaborators, called top-down once per scan
+// (docs/architecture.md walks one scan and one message through it):
 //
-//   front end: undistort the full scan (with reflectivity), detect, track and
-//     identify teammates at the predicted pose; add a T_Gi_Gj block for each
-//     newly identified teammate, drop those lost for good; build the active
-//     observation factors (this scan's clusters) and the passive ones
-//     (received messages in which a teammate saw this drone);
-//   update: prior + point-to-plane + active + passive (EsikfUpdate), only the
-//     extrinsic blocks of teammates observed in this scan estimated;
-//   teammate points are kept out of the map; then the outputs: ego state,
-//     every teammate's state in G_i, and the EgoStateMessage to broadcast.
+//   1. the odometry (lio::Odometry) queues the inputs and hands out each scan
+//      once IMU data cover it: preprocessed, propagated, undistorted;
+//   2. the detector (teammate::TeammateDetector) finds, tracks and
+//      identifies teammates in the scan's reflective points at the
+//      predicted pose;
+//   3. the teammate registry adds the extrinsic blocks T_Gi_Gj of newly
+//      identified teammates to the state and removes lost ones;
+//   4. each updater (active, passive, gravity; one per measurement type)
+//      turns its pending inputs into residual terms through the gate;
+//   5. the odometry's back end (filter or window) updates, and the map takes
+//      the scan without the teammates' points;
+//   6. the broadcaster queues the scan's messages; the output is returned.
+// Received messages go to the inbox, which hands each to its owner at once.
 //
 // Inputs: IMU samples, LiDAR scans (own clock), received messages (their
 // arrival time in the own clock). Outputs: PopOutputs, PopMessages. No I/O,
@@ -116,11 +118,11 @@ struct DroneEstimatorCounters {
 /// `indent`, ending with a newline.
 std::string FormatBroadcastCounters(const DroneEstimatorCounters& c, const std::string& indent);
 
-class DroneEstimator : public lio::ScanStageHooks {
+class DroneEstimator {
  public:
   static Status Create(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar,
                        std::unique_ptr<DroneEstimator>* estimator);
-  ~DroneEstimator() override;
+  ~DroneEstimator();
 
   Status AddImu(const ImuSample& sample);
   Status AddScan(const LidarScan& scan);
@@ -150,50 +152,26 @@ class DroneEstimator : public lio::ScanStageHooks {
   const DroneEstimatorCounters& counters() const { return counters_; }
   const DroneEstimatorOptions& options() const { return options_; }
 
-  // lio::ScanStageHooks
-  Status OnFrontEnd(const lio::FrontEndScan& scan, SwarmState* x, Eigen::MatrixXd* P,
-                    lio::UpdateRequest* request) override;
-  void OnScanDone(const lio::ScanOutput& output, const SwarmState& x,
-                  const Eigen::MatrixXd& P) override;
-
  private:
-  struct Impl;
+  struct Parts;
   DroneEstimator(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar);
 
-  // The raw points the detector needs: tape returns and points near the
-  // trackers of the last scan (predicted to t_k).
-  void SelectDetectorPoints(const LidarScan& raw, int64_t t_k, const SwarmState& x,
-                            const Eigen::Matrix3d& R_imu_lidar, LidarScan* selected) const;
-
-  // Identification through teammates (docs/swarm.md): adds every k that a
-  // first-hand teammate j identified and this drone has not.
-  void AddTeammatesThroughTeammates(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P);
-
-  // Whether a teammate's message stamped `sender_stamp_ns` (its clock) was
-  // made after this drone's session began (by max_message_age_s): false
-  // before the odometry initialized or the sender's clock offset is known.
-  bool MadeInThisSession(int sender_id, int64_t sender_stamp_ns) const;
-  // Whether a sender's message (its clock) about teammate k is from k's
-  // current session (k restarted: not before this drone heard the new
-  // session + max_message_age_s); true when k never restarted.
-  bool MadeInSessionOf(int teammate_id, int sender_id, int64_t sender_stamp_ns) const;
-
-  // The scan's broadcast (drone_estimator_broadcast.cc): the own state with
-  // what fits the byte budget of echoes, observations and repeats, and the
-  // own T_Gi_Gj estimates when new or due.
-  void Broadcast(const lio::ScanOutput& output, const SwarmState& x, const Eigen::MatrixXd& P);
-  // Keeps the observations of the state message `m` that the next message
-  // repeats (SwarmOptions::repeat_observations), moved into G_i.
-  void RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,
-                         const Eigen::MatrixXd& P);
+  // Every scan the odometry hands out, through the pass; the first error.
+  Status ProcessReadyScans(bool flush);
+  // One scan, top-down (steps 2-6 of the header comment).
+  Status ProcessScan(lio::ScanContext* scan);
+  // Steps 2-4: detection, the registry, the updaters' terms into `request`.
+  Status FrontEnd(lio::ScanContext* scan, lio::UpdateRequest* request);
+  // Step 6: the output of the scan and its broadcast.
+  void Finish(const lio::ScanContext& scan, lio::ScanOutput ego);
 
   int self_id_;
   DroneEstimatorOptions options_;
   LidarOptions lidar_;
   std::unique_ptr<lio::Odometry> odometry_;
   std::unique_ptr<teammate::TeammateDetector> detector_;
-  std::unique_ptr<Impl> impl_;
   DroneEstimatorCounters counters_;
+  std::unique_ptr<Parts> parts_;
   bool fusion_enabled_ = true;
 };
 

@@ -1,0 +1,51 @@
+#include "active_observation_updater.h"
+
+#include <cmath>
+#include <memory>
+
+#include "factors/active_observation_factor.h"
+#include "observation_terms.h"
+
+namespace swarmlio::swarm::internal {
+
+void ActiveObservationUpdater::AddTerms(const UpdaterScan& scan, ObservationGate* gate,
+                                        ScanReport* report) {
+  const SwarmOptions& so = options_;
+  if (!so.fuse_active || !scan.fusion_enabled) return;
+  const SwarmState& x = *scan.x;
+  const Eigen::Matrix3d R_Gi_bi = x.ego.R_G_b();
+  Teammates& teammates = registry_->teammates();
+  for (const teammate::TeammateObservation& o : *observations_) {
+    const auto it = teammates.find(o.drone_id);
+    if (!x.HasTeammate(o.drone_id) || it == teammates.end() || !it->second.have_message) {
+      continue;
+    }
+    const net::EgoStateMessage& m = it->second.last;
+    if (scan.skip_degenerate && m.degenerated) {
+      ++report->skipped_degenerate;
+      continue;
+    }
+    const double age = static_cast<double>(scan.t_k - m.stamp_ns) * 1e-9;
+    if (std::abs(age) > so.max_message_age_s) {
+      ++report->rejected;
+      ++counters_->observations_rejected;
+      continue;
+    }
+    const PredictedTeammate j = Predict(m, so.time_compensation ? age : 0.0);
+    const GlobalExtrinsic& T = x.teammate(o.drone_id);
+    const double share = ObservationShare(so, scan.previous_scan_degenerate, m.degenerated);
+    auto factor = std::make_unique<ActiveObservationFactor>(
+        o.p_bj_in_bi, j.p_bj_in_Gj, Regularized<3>(o.covariance_m2) / share,
+        Regularized<3>(j.cov_p), R_Gi_bi, T.R_Gi_Gj());
+    const Eigen::Vector3d e = factor->Predict(x.ego, T) - o.p_bj_in_bi;
+    const Eigen::Matrix3d S = factor->covariance();
+    if (gate->Add(std::move(factor), o.drone_id, e, S)) {
+      ++report->active;
+      ++report->fused_by_teammate[o.drone_id].first;
+      ++counters_->active_fused;
+      if (!gate->frozen()) ++it->second.observations_fused;
+    }
+  }
+}
+
+}  // namespace swarmlio::swarm::internal
