@@ -7,6 +7,9 @@
 #                             then fuzz the packet decoder (clang, libFuzzer) and run the threaded
 #                             tests under ThreadSanitizer (docs/network.md, "Fuzzing and sanitizers in CI")
 #   tools/swarmlio.sh fuzz    only the fuzz stage;  tools/swarmlio.sh tsan   only the TSan stage
+#   tools/swarmlio.sh tidy    only the static checks: clang-tidy (.clang-tidy: function size
+#                             and naming) on src/swarm, src/lio, src/window, and no function
+#                             in src/ over 120 lines
 #
 # Environment: BUILD_DIR (default build), ASAN_BUILD_DIR (default build-asan),
 # FUZZ_BUILD_DIR (default build-fuzz), TSAN_BUILD_DIR (default build-tsan),
@@ -39,6 +42,9 @@ PACKAGES=(
 # The fuzz stage needs clang and its libFuzzer/sanitizer runtimes.
 case "${1:-}" in
   test|fuzz) PACKAGES+=(clang libclang-rt-14-dev) ;;
+esac
+case "${1:-}" in
+  test|tidy) PACKAGES+=(clang-tidy universal-ctags) ;;
 esac
 
 log() { printf '\033[1m[swarmlio]\033[0m %s\n' "$*" >&2; }
@@ -80,7 +86,7 @@ configure_and_build() {
 
 setup() {
   install_packages
-  configure_and_build "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release
+  configure_and_build "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON
 }
 
 # configure_and_build_targets DIR "TARGET..." [extra cmake args...]: only those
@@ -152,6 +158,29 @@ tsan_stage() {
     -R "$TSAN_TESTS" --no-tests=error
 }
 
+# Static checks on the Release build's compile commands: clang-tidy with the
+# repository's .clang-tidy (functions <= 80 lines, naming) on the component
+# and estimator folders, and no function anywhere in src/ over 120 lines
+# (Universal Ctags gives each function's extent).
+TIDY_DIRS=(src/swarm src/lio src/window)
+tidy_stage() {
+  log "static checks: clang-tidy on ${TIDY_DIRS[*]}; function size in src/"
+  local files
+  files=$(cd "$ROOT" && git ls-files "${TIDY_DIRS[@]/%//*.cc}")
+  (cd "$ROOT" && printf '%s\n' $files | xargs -P"$JOBS" -n 4 clang-tidy -p "$BUILD_DIR" --quiet) \
+    2> >(grep -v -E '^[0-9]+ warnings? generated|^\*\* WARNING \*\*' >&2)
+  local long
+  long=$(cd "$ROOT" && ctags-universal -R --languages=C++ --kinds-C++=f --fields=+ne -x \
+           --_xformat='%{end} %{line} %{input}:%{name}' src |
+         awk '$1 ~ /^[0-9]+$/ && $2 ~ /^[0-9]+$/ && $1 - $2 + 1 > 120 {print $1 - $2 + 1 " lines " $3}')
+  if [[ -n "$long" ]]; then
+    log "functions over 120 lines in src/:"
+    echo "$long" >&2
+    return 1
+  fi
+  log "static checks passed"
+}
+
 run_tests() {
   local dir="$1"
   log "running tests in $dir"
@@ -178,6 +207,7 @@ case "$cmd" in
     ;;
   test)
     setup
+    tidy_stage
     run_tests "$BUILD_DIR"
     log "sanitizer stage: -fsanitize=address,undefined"
     configure_and_build "$ASAN_BUILD_DIR" "${SANITIZER_BUILD_TYPE[@]}" \
@@ -195,8 +225,12 @@ case "$cmd" in
     install_packages
     tsan_stage
     ;;
+  tidy)
+    setup
+    tidy_stage
+    ;;
   *)
-    echo "usage: tools/swarmlio.sh {setup|demo|test|fuzz|tsan}" >&2
+    echo "usage: tools/swarmlio.sh {setup|demo|test|fuzz|tsan|tidy}" >&2
     exit 2
     ;;
 esac

@@ -12,7 +12,7 @@
 namespace swarmlio::teammate {
 namespace {
 
-TEST(TeammateEndToEnd, Uav2IdentifiesBothTeammatesInIndoor3uav) {
+TEST(TeammateEndToEnd, Uav2IdentifiesBothTeammatesInIndoor3uavGivenTrueEgoPoses) {
   sim::Scenario scenario;
   ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
                                     "/configs/scenarios/indoor_3uav.yaml",
