@@ -206,9 +206,12 @@ bool AddTermInformation(const ResidualTerm& term, const std::vector<double*>& po
 
 // RunAll's input checks; on success *cholesky is the Cholesky factor of
 // P_hat that the prior takes.
-Status CheckRunInputs(const EsikfUpdateOptions& options, const SwarmState& x_hat,
-                      const Eigen::MatrixXd& P_hat, const SwarmState& x_start,
-                      const std::vector<MeasurementModel*>& models, Eigen::MatrixXd* cholesky) {
+Status CheckRunInputs(const EsikfUpdateOptions& options,
+                      const SwarmState& x_hat,
+                      const Eigen::MatrixXd& P_hat,
+                      const SwarmState& x_start,
+                      const std::vector<MeasurementModel*>& models,
+                      Eigen::MatrixXd* cholesky) {
   if (const std::string invalid = options.Validate(); !invalid.empty()) {
     return Status::InvalidArgument("EsikfUpdateOptions." + invalid);
   }
@@ -219,9 +222,9 @@ Status CheckRunInputs(const EsikfUpdateOptions& options, const SwarmState& x_hat
     if (m == nullptr) return Status::InvalidArgument("EsikfUpdate: null measurement model");
   }
   if (P_hat.rows() != x_hat.Dim() || !PriorFactor::CholeskyOfCovariance(P_hat, cholesky)) {
-    return Status::InvalidArgument(
-        "EsikfUpdate: P_hat must be a " + std::to_string(x_hat.Dim()) + "x" +
-        std::to_string(x_hat.Dim()) + " symmetric positive-definite matrix");
+    return Status::InvalidArgument("EsikfUpdate: P_hat must be a " + std::to_string(x_hat.Dim()) +
+                                   "x" + std::to_string(x_hat.Dim()) +
+                                   " symmetric positive-definite matrix");
   }
   return Status::Ok();
 }
@@ -265,11 +268,12 @@ struct UpdateProblem {
   ceres::Problem problem;
 };
 
-
 // Adds one residual block per term of `measurements` to `problem`, on the
 // parameter blocks (`pointers`, in `layout`'s slot order) the term names.
-Status AddMeasurementBlocks(const std::vector<double*>& pointers, const ErrorStateLayout& layout,
-                            ceres::Problem* problem, MeasurementBlocks* measurements) {
+Status AddMeasurementBlocks(const std::vector<double*>& pointers,
+                            const ErrorStateLayout& layout,
+                            ceres::Problem* problem,
+                            MeasurementBlocks* measurements) {
   std::vector<double*> term_pointers;
   for (const ResidualTerm& term : measurements->terms) {
     term_pointers.clear();
@@ -280,12 +284,10 @@ Status AddMeasurementBlocks(const std::vector<double*>& pointers, const ErrorSta
         term_pointers.push_back(pointers[static_cast<size_t>(layout.SlotOf(block)) + 1]);
       } else {
         return Status::InvalidArgument("EsikfUpdate: a residual block names teammate " +
-                                       std::to_string(block) +
-                                       ", absent from the estimated state");
+                                       std::to_string(block) + ", absent from the estimated state");
       }
     }
-    if (term.cost == nullptr ||
-        term.cost->parameter_block_sizes().size() != term_pointers.size()) {
+    if (term.cost == nullptr || term.cost->parameter_block_sizes().size() != term_pointers.size()) {
       return Status::InvalidArgument(
           "EsikfUpdate: a residual block's cost does not match its block list");
     }
@@ -297,8 +299,10 @@ Status AddMeasurementBlocks(const std::vector<double*>& pointers, const ErrorSta
 
 // Drops last iteration's measurement blocks, re-linearizes every model at x
 // (timed into *association_time_s) and adds the new blocks to the problem.
-Status Relinearize(const std::vector<MeasurementModel*>& models, const SwarmState& x,
-                   UpdateProblem* up, double* association_time_s) {
+Status Relinearize(const std::vector<MeasurementModel*>& models,
+                   const SwarmState& x,
+                   UpdateProblem* up,
+                   double* association_time_s) {
   ceres::Problem* problem = &up->problem;
   MeasurementBlocks* measurements = &up->measurements;
   for (ceres::ResidualBlockId id : measurements->ids) problem->RemoveResidualBlock(id);
@@ -323,7 +327,8 @@ Status Relinearize(const std::vector<MeasurementModel*>& models, const SwarmStat
 // ErrorStateLayout order. The prior's in closed form; a model's through its
 // fast path (AddInformation) when it has one, else from its blocks'
 // Jacobians and the manifolds' PlusJacobian.
-Status PosteriorCovariance(const UpdateProblem& up, const SwarmState& x,
+Status PosteriorCovariance(const UpdateProblem& up,
+                           const SwarmState& x,
                            const std::vector<MeasurementModel*>& models,
                            Eigen::MatrixXd* covariance) {
   const MeasurementBlocks& measurements = up.measurements;
@@ -353,7 +358,8 @@ Status PosteriorCovariance(const UpdateProblem& up, const SwarmState& x,
 // id must be present, once, and in one list only.
 Status SelectTeammates(const ErrorStateLayout& layout,
                        const std::vector<int>* estimated_teammates,
-                       const std::vector<int>* considered_teammates, std::vector<int>* ids,
+                       const std::vector<int>* considered_teammates,
+                       std::vector<int>* ids,
                        std::vector<int>* considered) {
   const auto listed = [](const std::vector<int>* list, int id) {
     return list != nullptr && std::find(list->begin(), list->end(), id) != list->end();
@@ -405,7 +411,8 @@ void CopyRunStatistics(const EsikfUpdateResult& sub, EsikfUpdateResult* result) 
 // Schmidt-Kalman: P_os^+ = P_os (I - K H)^T in the tangent space at the
 // solution x_s, i.e. P_os P_ss^-1 J P_ss^+ with J = d(x (-) x_hat)/d dx at
 // the solution (identity at x_hat; docs/esikf.md).
-Eigen::MatrixXd SchmidtKalmanCrossCovariance(const SwarmState& x_hat_s, const SwarmState& x_s,
+Eigen::MatrixXd SchmidtKalmanCrossCovariance(const SwarmState& x_hat_s,
+                                             const SwarmState& x_s,
                                              const std::vector<int>& ids,
                                              const Eigen::MatrixXd& P_os,
                                              const Eigen::MatrixXd& P_ss,
@@ -422,8 +429,10 @@ Eigen::MatrixXd SchmidtKalmanCrossCovariance(const SwarmState& x_hat_s, const Sw
 
 // Writes the sub-update's covariance P_ss^+ and the cross-covariance
 // P_os^+ (and its transpose) into the full P.
-void ScatterCovariance(const std::vector<int>& s_idx, const std::vector<int>& o_idx,
-                       const Eigen::MatrixXd& P_ss_plus, const Eigen::MatrixXd& P_os_plus,
+void ScatterCovariance(const std::vector<int>& s_idx,
+                       const std::vector<int>& o_idx,
+                       const Eigen::MatrixXd& P_ss_plus,
+                       const Eigen::MatrixXd& P_os_plus,
                        Eigen::MatrixXd* P_out) {
   Eigen::MatrixXd& P = *P_out;
   for (size_t r = 0; r < s_idx.size(); ++r) {
@@ -443,7 +452,8 @@ void ScatterCovariance(const std::vector<int>& s_idx, const std::vector<int>& o_
 // the considered blocks) is restored from P_hat.
 void RestoreConsideredCovariance(const ErrorStateLayout& layout,
                                  const std::vector<int>& considered,
-                                 const std::vector<int>& o_idx, const Eigen::MatrixXd& P_hat,
+                                 const std::vector<int>& o_idx,
+                                 const Eigen::MatrixXd& P_hat,
                                  Eigen::MatrixXd* P_out) {
   Eigen::MatrixXd& P = *P_out;
   std::vector<int> not_estimated = o_idx;

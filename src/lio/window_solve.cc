@@ -240,7 +240,8 @@ bool WindowSmoother::Impl::StepIsSmall(const std::vector<double>& start) const {
 
 void WindowSmoother::Impl::Iterate(const std::vector<WindowScan*>& active,
                                    const std::vector<WindowScan*>& associated,
-                                   ceres::Problem* problem, WindowSolveResult* result) {
+                                   ceres::Problem* problem,
+                                   WindowSolveResult* result) {
   ceres::Solver::Options solver_options = GaussNewtonStepOptions(ToCeres(options.linear_solver));
   solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   for (int it = 0; it < options.max_iterations; ++it) {
@@ -271,8 +272,8 @@ void WindowSmoother::Impl::FinishIterations(const std::vector<double>& before,
                                             const std::vector<WindowScan*>& active,
                                             WindowSolveResult* result) {
   const std::vector<double> after = Values();
-  const bool finite = std::all_of(after.begin(), after.end(),
-                                  [](double v) { return std::isfinite(v); });
+  const bool finite =
+      std::all_of(after.begin(), after.end(), [](double v) { return std::isfinite(v); });
   if (result->status.ok() && !finite) {
     result->status = Status::Internal("window: non-finite solution");
   }

@@ -146,11 +146,14 @@ struct WindowSmoother::Impl {
   // Every state's step from `start` (Values()) below the update's thresholds.
   bool StepIsSmall(const std::vector<double>& start) const;
   // The Gauss-Newton iterations with re-association.
-  void Iterate(const std::vector<WindowScan*>& active, const std::vector<WindowScan*>& associated,
-               ceres::Problem* problem, WindowSolveResult* result);
+  void Iterate(const std::vector<WindowScan*>& active,
+               const std::vector<WindowScan*>& associated,
+               ceres::Problem* problem,
+               WindowSolveResult* result);
   // After the iterations: restores `before` on failure (or a non-finite
   // solution), re-linearizes the active planes, reports the newest scan's.
-  void FinishIterations(const std::vector<double>& before, const std::vector<WindowScan*>& active,
+  void FinishIterations(const std::vector<double>& before,
+                        const std::vector<WindowScan*>& active,
                         WindowSolveResult* result);
   Status NewestCovariance(Eigen::MatrixXd* P) const;
   void ReadState(SwarmState* x) const;

@@ -214,8 +214,11 @@ Status NormalEquations(const std::vector<MarginalizationResidualBlock>& residual
 // the threshold): W = H_km V_s diag(1/sqrt(l_s)), H* = H_kk - W W^T (symmetric by
 // construction), b* = b_k - W diag(1/sqrt(l_s)) V_s^T b_m. Fills the prior's
 // information, gradient, marginalized_dim and marginalized_rank.
-Status SchurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, int kept_dim,
-                       int marginalized_dim, double min_relative_eigenvalue,
+Status SchurComplement(const Eigen::MatrixXd& H,
+                       const Eigen::VectorXd& b,
+                       int kept_dim,
+                       int marginalized_dim,
+                       double min_relative_eigenvalue,
                        MarginalizationPrior* out) {
   const Eigen::MatrixXd H_mm =
       0.5 * (H.bottomRightCorner(marginalized_dim, marginalized_dim) +
@@ -300,7 +303,8 @@ Status Marginalizer::Marginalize(const std::vector<double*>& marginalized,
 
   // Each residual's blocks, with consistent sizes and manifolds.
   std::vector<std::vector<int>> residual_slots;
-  SWARMLIO_RETURN_IF_ERROR(ResolveResidualBlocks(residual_blocks_, index, &blocks, &residual_slots));
+  SWARMLIO_RETURN_IF_ERROR(
+      ResolveResidualBlocks(residual_blocks_, index, &blocks, &residual_slots));
   int dim = 0;
   int kept_dim = 0;
   SWARMLIO_RETURN_IF_ERROR(AssignOffsets(&blocks, &dim, &kept_dim));
@@ -310,8 +314,8 @@ Status Marginalizer::Marginalize(const std::vector<double*>& marginalized,
   Eigen::VectorXd b;
   SWARMLIO_RETURN_IF_ERROR(NormalEquations(residual_blocks_, blocks, residual_slots, dim, &H, &b));
   MarginalizationPrior out;
-  SWARMLIO_RETURN_IF_ERROR(SchurComplement(H, b, kept_dim, marginalized_dim,
-                                           options_.min_relative_eigenvalue, &out));
+  SWARMLIO_RETURN_IF_ERROR(
+      SchurComplement(H, b, kept_dim, marginalized_dim, options_.min_relative_eigenvalue, &out));
   for (const Block& block : blocks) {
     if (!block.kept) continue;
     out.parameter_blocks.push_back(block.values);
