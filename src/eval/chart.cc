@@ -60,7 +60,7 @@ std::string FormatTick(double value, double step) {
   return text;
 }
 
-std::vector<double> Ticks(const Range& range, double step) {
+std::vector<double> TickValues(const Range& range, double step) {
   std::vector<double> ticks;
   const double first = std::ceil(range.min / step - 1e-9) * step;
   for (int k = 0; k < 1000; ++k) {
@@ -123,14 +123,11 @@ double NiceTickStep(double range, int target) {
   return nice * magnitude;
 }
 
-Status RenderChartPng(const ChartSpec& spec, const std::string& path) {
-  if (spec.width_px < kMinSizePx || spec.width_px > kMaxSizePx || spec.height_px < kMinSizePx ||
-      spec.height_px > kMaxSizePx) {
-    return Status::InvalidArgument("plot: size " + std::to_string(spec.width_px) + " x " +
-                                   std::to_string(spec.height_px) + " px is outside [200, 8000]");
-  }
-  Range x_range;
-  Range y_range;
+namespace {
+
+// The ranges of the finite points (y including 0 with y_from_zero);
+// InvalidArgument when a line's x and y differ in length or no point is finite.
+Status DataRanges(const ChartSpec& spec, Range* x_range, Range* y_range) {
   for (const ChartLine& line : spec.lines) {
     if (line.x.size() != line.y.size()) {
       return Status::InvalidArgument("plot: line '" + line.label + "' has " +
@@ -139,24 +136,34 @@ Status RenderChartPng(const ChartSpec& spec, const std::string& path) {
     }
     for (size_t i = 0; i < line.x.size(); ++i) {
       if (std::isfinite(line.x[i]) && std::isfinite(line.y[i])) {
-        x_range.Add(line.x[i]);
-        y_range.Add(line.y[i]);
+        x_range->Add(line.x[i]);
+        y_range->Add(line.y[i]);
       }
     }
   }
-  if (!x_range.valid()) return Status::InvalidArgument("plot: no finite point to plot");
-  if (spec.y_from_zero) y_range.Add(0.0);
+  if (!x_range->valid()) return Status::InvalidArgument("plot: no finite point to plot");
+  if (spec.y_from_zero) y_range->Add(0.0);
+  return Status::Ok();
+}
 
-  const std::unique_ptr<cairo_surface_t, CairoDeleter> surface(
-      cairo_image_surface_create(CAIRO_FORMAT_RGB24, spec.width_px, spec.height_px));
-  if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {
-    return Status::Internal(std::string("plot: cairo surface: ") +
-                            cairo_status_to_string(cairo_surface_status(surface.get())));
-  }
-  const std::unique_ptr<cairo_t, CairoDeleter> context(cairo_create(surface.get()));
-  cairo_t* cr = context.get();
+// The plot area in pixels and the data ranges it shows.
+struct PlotArea {
+  double left = 0.0;
+  double right = 0.0;
+  double top = 0.0;
+  double bottom = 0.0;
+  double plot_w = 0.0;
+  double plot_h = 0.0;
+  Range x_range;
+  Range y_range;
 
-  // Layout: the legend sits right of the plot area.
+  double ToPxX(double x) const { return left + (x - x_range.min) / x_range.span() * plot_w; }
+  double ToPxY(double y) const { return bottom - (y - y_range.min) / y_range.span() * plot_h; }
+};
+
+// Layout: the legend sits right of the plot area. InvalidArgument when it
+// leaves no room for the plot.
+Status LayOut(cairo_t* cr, const ChartSpec& spec, PlotArea* area) {
   SetFont(cr, kLegendFontPx, false);
   double legend_width = 0.0;
   for (const ChartLine& line : spec.lines) {
@@ -173,9 +180,20 @@ Status RenderChartPng(const ChartSpec& spec, const std::string& path) {
         "plot: the legend leaves no room for the plot; use a wider image "
         "or shorter names");
   }
-  const double plot_w = right - left;
-  const double plot_h = bottom - top;
+  area->left = left;
+  area->right = right;
+  area->top = top;
+  area->bottom = bottom;
+  area->plot_w = right - left;
+  area->plot_h = bottom - top;
+  return Status::Ok();
+}
 
+// The data ranges the area shows: padded, and with equal_axes widened to
+// the same units per pixel on both axes.
+void FitRanges(const ChartSpec& spec, Range x_range, Range y_range, PlotArea* area) {
+  const double plot_w = area->plot_w;
+  const double plot_h = area->plot_h;
   x_range.Pad(kDataPadFraction, false);
   y_range.Pad(kDataPadFraction, spec.y_from_zero);
   if (spec.equal_axes) {
@@ -185,52 +203,75 @@ Status RenderChartPng(const ChartSpec& spec, const std::string& path) {
     x_range = {x_mid - 0.5 * units_per_px * plot_w, x_mid + 0.5 * units_per_px * plot_w};
     y_range = {y_mid - 0.5 * units_per_px * plot_h, y_mid + 0.5 * units_per_px * plot_h};
   }
-  auto to_px_x = [&](double x) { return left + (x - x_range.min) / x_range.span() * plot_w; };
-  auto to_px_y = [&](double y) { return bottom - (y - y_range.min) / y_range.span() * plot_h; };
+  area->x_range = x_range;
+  area->y_range = y_range;
+}
 
-  // Background, grid, frame.
-  cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
-  cairo_paint(cr);
-  const double x_step = NiceTickStep(x_range.span(), kTargetTicks);
-  const double y_step =
-      NiceTickStep(y_range.span(), std::max(2, static_cast<int>(kTargetTicks * plot_h / plot_w)));
-  const std::vector<double> x_ticks = Ticks(x_range, x_step);
-  const std::vector<double> y_ticks = Ticks(y_range, y_step);
+struct Ticks {
+  double x_step = 0.0;
+  double y_step = 0.0;
+  std::vector<double> x;
+  std::vector<double> y;
+};
+
+// About kTargetTicks intervals on x, as many per pixel on y.
+Ticks MakeTicks(const PlotArea& area) {
+  Ticks ticks;
+  ticks.x_step = NiceTickStep(area.x_range.span(), kTargetTicks);
+  ticks.y_step = NiceTickStep(
+      area.y_range.span(), std::max(2, static_cast<int>(kTargetTicks * area.plot_h / area.plot_w)));
+  ticks.x = TickValues(area.x_range, ticks.x_step);
+  ticks.y = TickValues(area.y_range, ticks.y_step);
+  return ticks;
+}
+
+void DrawGridAndFrame(cairo_t* cr, const PlotArea& area, const Ticks& ticks) {
   cairo_set_line_width(cr, 1.0);
   cairo_set_source_rgb(cr, 0.88, 0.88, 0.88);
-  for (const double t : x_ticks) {
-    const double px = std::round(to_px_x(t)) + 0.5;
-    cairo_move_to(cr, px, top);
-    cairo_line_to(cr, px, bottom);
+  for (const double t : ticks.x) {
+    const double px = std::round(area.ToPxX(t)) + 0.5;
+    cairo_move_to(cr, px, area.top);
+    cairo_line_to(cr, px, area.bottom);
   }
-  for (const double t : y_ticks) {
-    const double py = std::round(to_px_y(t)) + 0.5;
-    cairo_move_to(cr, left, py);
-    cairo_line_to(cr, right, py);
+  for (const double t : ticks.y) {
+    const double py = std::round(area.ToPxY(t)) + 0.5;
+    cairo_move_to(cr, area.left, py);
+    cairo_line_to(cr, area.right, py);
   }
   cairo_stroke(cr);
   cairo_set_source_rgb(cr, 0.0, 0.0, 0.0);
-  cairo_rectangle(cr, std::round(left) + 0.5, std::round(top) + 0.5, std::round(plot_w),
-                  std::round(plot_h));
+  cairo_rectangle(cr, std::round(area.left) + 0.5, std::round(area.top) + 0.5,
+                  std::round(area.plot_w), std::round(area.plot_h));
   cairo_stroke(cr);
+}
 
-  // Tick labels, axis labels, title.
+// Tick labels, axis labels, title.
+void DrawLabels(cairo_t* cr, const ChartSpec& spec, const PlotArea& area, const Ticks& ticks) {
+  const double left = area.left;
+  const double top = area.top;
+  const double bottom = area.bottom;
   SetFont(cr, kTickFontPx, false);
-  for (const double t : x_ticks) DrawText(cr, FormatTick(t, x_step), to_px_x(t), bottom + 16, 0.5);
-  for (const double t : y_ticks) DrawText(cr, FormatTick(t, y_step), left - 8, to_px_y(t), 1.0);
+  for (const double t : ticks.x) {
+    DrawText(cr, FormatTick(t, ticks.x_step), area.ToPxX(t), bottom + 16, 0.5);
+  }
+  for (const double t : ticks.y) {
+    DrawText(cr, FormatTick(t, ticks.y_step), left - 8, area.ToPxY(t), 1.0);
+  }
   SetFont(cr, kLabelFontPx, false);
-  DrawText(cr, spec.x_label, left + plot_w / 2, bottom + 50, 0.5);
+  DrawText(cr, spec.x_label, left + area.plot_w / 2, bottom + 50, 0.5);
   cairo_save(cr);
-  cairo_translate(cr, 24, top + plot_h / 2);
+  cairo_translate(cr, 24, top + area.plot_h / 2);
   cairo_rotate(cr, -kHalfPi);
   DrawText(cr, spec.y_label, 0, 0, 0.5);
   cairo_restore(cr);
   SetFont(cr, kTitleFontPx, true);
   DrawText(cr, spec.title, spec.width_px / 2.0, top / 2, 0.5);
+}
 
-  // Lines, clipped to the plot area.
+// Lines, clipped to the plot area.
+void DrawLines(cairo_t* cr, const ChartSpec& spec, const PlotArea& area) {
   cairo_save(cr);
-  cairo_rectangle(cr, left, top, plot_w, plot_h);
+  cairo_rectangle(cr, area.left, area.top, area.plot_w, area.plot_h);
   cairo_clip(cr);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
@@ -242,8 +283,8 @@ Status RenderChartPng(const ChartSpec& spec, const std::string& path) {
         pen_down = false;
         continue;
       }
-      const double px = to_px_x(line.x[i]);
-      const double py = to_px_y(line.y[i]);
+      const double px = area.ToPxX(line.x[i]);
+      const double py = area.ToPxY(line.y[i]);
       if (pen_down) {
         cairo_line_to(cr, px, py);
       } else {
@@ -255,13 +296,16 @@ Status RenderChartPng(const ChartSpec& spec, const std::string& path) {
     cairo_stroke(cr);
   }
   cairo_restore(cr);
+}
 
-  // Legend.
+// The legend, right of the plot area: a line sample and the label per
+// labelled line.
+void DrawLegend(cairo_t* cr, const ChartSpec& spec, const PlotArea& area) {
   SetFont(cr, kLegendFontPx, false);
-  double legend_y = top + 14;
+  double legend_y = area.top + 14;
   for (const ChartLine& line : spec.lines) {
     if (line.label.empty()) continue;
-    const double x0 = right + 20;
+    const double x0 = area.right + 20;
     SetLineStyle(cr, line);
     cairo_move_to(cr, x0, legend_y);
     cairo_line_to(cr, x0 + kLegendSamplePx, legend_y);
@@ -270,6 +314,41 @@ Status RenderChartPng(const ChartSpec& spec, const std::string& path) {
     DrawText(cr, line.label, x0 + kLegendSamplePx + 10, legend_y, 0.0);
     legend_y += kLegendRowPx;
   }
+}
+
+}  // namespace
+
+Status RenderChartPng(const ChartSpec& spec, const std::string& path) {
+  if (spec.width_px < kMinSizePx || spec.width_px > kMaxSizePx || spec.height_px < kMinSizePx ||
+      spec.height_px > kMaxSizePx) {
+    return Status::InvalidArgument("plot: size " + std::to_string(spec.width_px) + " x " +
+                                   std::to_string(spec.height_px) + " px is outside [200, 8000]");
+  }
+  Range x_range;
+  Range y_range;
+  SWARMLIO_RETURN_IF_ERROR(DataRanges(spec, &x_range, &y_range));
+
+  const std::unique_ptr<cairo_surface_t, CairoDeleter> surface(
+      cairo_image_surface_create(CAIRO_FORMAT_RGB24, spec.width_px, spec.height_px));
+  if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {
+    return Status::Internal(std::string("plot: cairo surface: ") +
+                            cairo_status_to_string(cairo_surface_status(surface.get())));
+  }
+  const std::unique_ptr<cairo_t, CairoDeleter> context(cairo_create(surface.get()));
+  cairo_t* cr = context.get();
+
+  PlotArea area;
+  SWARMLIO_RETURN_IF_ERROR(LayOut(cr, spec, &area));
+  FitRanges(spec, x_range, y_range, &area);
+
+  // Background, grid, frame.
+  cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
+  cairo_paint(cr);
+  const Ticks ticks = MakeTicks(area);
+  DrawGridAndFrame(cr, area, ticks);
+  DrawLabels(cr, spec, area, ticks);
+  DrawLines(cr, spec, area);
+  DrawLegend(cr, spec, area);
 
   if (cairo_status(cr) != CAIRO_STATUS_SUCCESS) {
     return Status::Internal(std::string("plot: cairo: ") +

@@ -204,6 +204,271 @@ bool AddTermInformation(const ResidualTerm& term, const std::vector<double*>& po
   return true;
 }
 
+// RunAll's input checks; on success *cholesky is the Cholesky factor of
+// P_hat that the prior takes.
+Status CheckRunInputs(const EsikfUpdateOptions& options,
+                      const SwarmState& x_hat,
+                      const Eigen::MatrixXd& P_hat,
+                      const SwarmState& x_start,
+                      const std::vector<MeasurementModel*>& models,
+                      Eigen::MatrixXd* cholesky) {
+  if (const std::string invalid = options.Validate(); !invalid.empty()) {
+    return Status::InvalidArgument("EsikfUpdateOptions." + invalid);
+  }
+  if (x_start.layout() != x_hat.layout()) {
+    return Status::InvalidArgument("EsikfUpdate: x_start and x_hat have different layouts");
+  }
+  for (const MeasurementModel* m : models) {
+    if (m == nullptr) return Status::InvalidArgument("EsikfUpdate: null measurement model");
+  }
+  if (P_hat.rows() != x_hat.Dim() || !PriorFactor::CholeskyOfCovariance(P_hat, cholesky)) {
+    return Status::InvalidArgument("EsikfUpdate: P_hat must be a " + std::to_string(x_hat.Dim()) +
+                                   "x" + std::to_string(x_hat.Dim()) +
+                                   " symmetric positive-definite matrix");
+  }
+  return Status::Ok();
+}
+
+// A problem that points to cost functions and manifolds its caller owns.
+ceres::Problem::Options NonOwningProblemOptions() {
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.enable_fast_removal = true;
+  return problem_options;
+}
+
+// The models' residual blocks at the current linearization point.
+struct MeasurementBlocks {
+  std::vector<ResidualTerm> terms;
+  std::vector<size_t> model_terms;  // terms of model k: [model_terms[k], model_terms[k + 1])
+  std::vector<ceres::ResidualBlockId> ids;  // in the problem, one per term
+};
+
+// The Ceres problem of one update: the state's parameter blocks (ego, then
+// the teammates in slot order) on their manifolds, the prior, and the
+// measurement blocks of the current linearization. Everything the problem
+// points to outlives it (declared before it).
+struct UpdateProblem {
+  UpdateProblem(const SwarmState& x_hat, Eigen::MatrixXd cholesky, const SwarmState& x)
+      : prior(x_hat, std::move(cholesky)), blocks(x), problem(NonOwningProblemOptions()) {
+    const std::vector<double*>& pointers = blocks.pointers();
+    problem.AddParameterBlock(pointers[0], EgoState::kAmbientSize, &ego_manifold);
+    for (size_t b = 1; b < pointers.size(); ++b) {
+      problem.AddParameterBlock(pointers[b], GlobalExtrinsic::kAmbientSize, &teammate_manifold);
+    }
+    problem.AddResidualBlock(&prior, nullptr, pointers);
+  }
+
+  EgoStateManifold ego_manifold;
+  GlobalExtrinsicManifold teammate_manifold;
+  PriorFactor prior;
+  ParameterBlocks blocks;
+  MeasurementBlocks measurements;
+  ceres::Problem problem;
+};
+
+// Adds one residual block per term of `measurements` to `problem`, on the
+// parameter blocks (`pointers`, in `layout`'s slot order) the term names.
+Status AddMeasurementBlocks(const std::vector<double*>& pointers,
+                            const ErrorStateLayout& layout,
+                            ceres::Problem* problem,
+                            MeasurementBlocks* measurements) {
+  std::vector<double*> term_pointers;
+  for (const ResidualTerm& term : measurements->terms) {
+    term_pointers.clear();
+    for (int block : term.blocks) {
+      if (block == kEgoBlock) {
+        term_pointers.push_back(pointers[0]);
+      } else if (layout.HasTeammate(block)) {
+        term_pointers.push_back(pointers[static_cast<size_t>(layout.SlotOf(block)) + 1]);
+      } else {
+        return Status::InvalidArgument("EsikfUpdate: a residual block names teammate " +
+                                       std::to_string(block) + ", absent from the estimated state");
+      }
+    }
+    if (term.cost == nullptr || term.cost->parameter_block_sizes().size() != term_pointers.size()) {
+      return Status::InvalidArgument(
+          "EsikfUpdate: a residual block's cost does not match its block list");
+    }
+    measurements->ids.push_back(problem->AddResidualBlock(
+        const_cast<ceres::CostFunction*>(term.cost), nullptr, term_pointers));
+  }
+  return Status::Ok();
+}
+
+// Drops last iteration's measurement blocks, re-linearizes every model at x
+// (timed into *association_time_s) and adds the new blocks to the problem.
+Status Relinearize(const std::vector<MeasurementModel*>& models,
+                   const SwarmState& x,
+                   UpdateProblem* up,
+                   double* association_time_s) {
+  ceres::Problem* problem = &up->problem;
+  MeasurementBlocks* measurements = &up->measurements;
+  for (ceres::ResidualBlockId id : measurements->ids) problem->RemoveResidualBlock(id);
+  measurements->ids.clear();
+  measurements->terms.clear();
+  measurements->model_terms.assign(1, 0);
+  const Clock::time_point t_assoc = Clock::now();
+  for (MeasurementModel* model : models) {
+    const Status status = model->Linearize(x, &measurements->terms);
+    measurements->model_terms.push_back(measurements->terms.size());
+    if (!status.ok()) {
+      *association_time_s += SecondsSince(t_assoc);
+      return status.WithContext(std::string("EsikfUpdate: ") + model->name());
+    }
+  }
+  *association_time_s += SecondsSince(t_assoc);
+  return AddMeasurementBlocks(up->blocks.pointers(), x.layout(), problem, measurements);
+}
+
+// Posterior (J^T J)^-1 at the final estimate x (the parameter blocks hold
+// its values): the tangent Jacobian of every residual block, columns in
+// ErrorStateLayout order. The prior's in closed form; a model's through its
+// fast path (AddInformation) when it has one, else from its blocks'
+// Jacobians and the manifolds' PlusJacobian.
+Status PosteriorCovariance(const UpdateProblem& up,
+                           const SwarmState& x,
+                           const std::vector<MeasurementModel*>& models,
+                           Eigen::MatrixXd* covariance) {
+  const MeasurementBlocks& measurements = up.measurements;
+  const Eigen::MatrixXd J_prior = up.prior.TangentJacobian(x);
+  Eigen::MatrixXd information = J_prior.transpose() * J_prior;
+  for (size_t k = 0; k < models.size(); ++k) {
+    if (models[k]->AddInformation(x, &information)) continue;
+    for (size_t t = measurements.model_terms[k]; t < measurements.model_terms[k + 1]; ++t) {
+      if (!AddTermInformation(measurements.terms[t], up.blocks.pointers(), x.layout(),
+                              up.ego_manifold, up.teammate_manifold, &information)) {
+        return Status::Internal("EsikfUpdate: Jacobian evaluation failed");
+      }
+    }
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(information);
+  if (llt.info() != Eigen::Success) {
+    return Status::Internal("EsikfUpdate: posterior information is not positive definite");
+  }
+  Eigen::MatrixXd P = llt.solve(Eigen::MatrixXd::Identity(x.Dim(), x.Dim()));
+  P = 0.5 * (P + P.transpose());
+  *covariance = std::move(P);
+  return Status::Ok();
+}
+
+// The blocks of a partial update: `ids`, the teammates in the solve
+// (estimated and considered) in layout order, and `considered`. Every listed
+// id must be present, once, and in one list only.
+Status SelectTeammates(const ErrorStateLayout& layout,
+                       const std::vector<int>* estimated_teammates,
+                       const std::vector<int>* considered_teammates,
+                       std::vector<int>* ids,
+                       std::vector<int>* considered) {
+  const auto listed = [](const std::vector<int>* list, int id) {
+    return list != nullptr && std::find(list->begin(), list->end(), id) != list->end();
+  };
+  size_t num_estimated = 0;
+  for (int id : layout.teammate_ids()) {
+    const bool is_considered = listed(considered_teammates, id);
+    const bool is_estimated =
+        estimated_teammates == nullptr ? !is_considered : listed(estimated_teammates, id);
+    if (is_considered && is_estimated) {
+      return Status::InvalidArgument("EsikfUpdate: teammate " + std::to_string(id) +
+                                     " is both estimated and considered");
+    }
+    if (is_considered) considered->push_back(id);
+    if (is_estimated) ++num_estimated;
+    if (is_considered || is_estimated) ids->push_back(id);
+  }
+  if ((estimated_teammates != nullptr && num_estimated != estimated_teammates->size()) ||
+      (considered_teammates != nullptr && considered->size() != considered_teammates->size())) {
+    return Status::InvalidArgument(
+        "EsikfUpdate: estimated_teammates or considered_teammates names a teammate absent from "
+        "the state (or twice)");
+  }
+  return Status::Ok();
+}
+
+// The indices in [0, dim) that `idx` does not hold, ascending.
+std::vector<int> Complement(const std::vector<int>& idx, int dim) {
+  std::vector<int> rest;
+  for (int k = 0; k < dim; ++k) {
+    if (std::find(idx.begin(), idx.end(), k) == idx.end()) rest.push_back(k);
+  }
+  return rest;
+}
+
+// The sub-update's counters and timings.
+void CopyRunStatistics(const EsikfUpdateResult& sub, EsikfUpdateResult* result) {
+  result->status = sub.status;
+  result->iterations = sub.iterations;
+  result->converged = sub.converged;
+  result->num_residual_blocks = sub.num_residual_blocks;
+  result->num_rejected_steps = sub.num_rejected_steps;
+  result->association_time_s = sub.association_time_s;
+  result->solve_time_s = sub.solve_time_s;
+  result->covariance_time_s = sub.covariance_time_s;
+  result->total_time_s = sub.total_time_s;
+}
+
+// Schmidt-Kalman: P_os^+ = P_os (I - K H)^T in the tangent space at the
+// solution x_s, i.e. P_os P_ss^-1 J P_ss^+ with J = d(x (-) x_hat)/d dx at
+// the solution (identity at x_hat; docs/esikf.md).
+Eigen::MatrixXd SchmidtKalmanCrossCovariance(const SwarmState& x_hat_s,
+                                             const SwarmState& x_s,
+                                             const std::vector<int>& ids,
+                                             const Eigen::MatrixXd& P_os,
+                                             const Eigen::MatrixXd& P_ss,
+                                             const Eigen::MatrixXd& P_ss_plus) {
+  const Eigen::VectorXd e = x_s.BoxMinus(x_hat_s);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Identity(x_hat_s.Dim(), x_hat_s.Dim());
+  J.block<3, 3>(0, 0) = so3::RightJacobianInverse(e.head<3>());
+  for (int id : ids) {
+    const int o = x_hat_s.layout().TeammateRotation(id).offset;
+    J.block<3, 3>(o, o) = so3::RightJacobianInverse(e.segment<3>(o));
+  }
+  return P_ss.llt().solve(P_os.transpose()).transpose() * J * P_ss_plus;
+}
+
+// Writes the sub-update's covariance P_ss^+ and the cross-covariance
+// P_os^+ (and its transpose) into the full P.
+void ScatterCovariance(const std::vector<int>& s_idx,
+                       const std::vector<int>& o_idx,
+                       const Eigen::MatrixXd& P_ss_plus,
+                       const Eigen::MatrixXd& P_os_plus,
+                       Eigen::MatrixXd* P_out) {
+  Eigen::MatrixXd& P = *P_out;
+  for (size_t r = 0; r < s_idx.size(); ++r) {
+    for (size_t c = 0; c < s_idx.size(); ++c) P(s_idx[r], s_idx[c]) = P_ss_plus(r, c);
+  }
+  for (size_t r = 0; r < o_idx.size(); ++r) {
+    for (size_t c = 0; c < s_idx.size(); ++c) {
+      P(o_idx[r], s_idx[c]) = P(s_idx[c], o_idx[r]) = P_os_plus(r, c);
+    }
+  }
+}
+
+// Considered blocks: held at x_hat in the solve (RunAll), whose joint step
+// gives the estimated blocks the Schmidt-Kalman gain and cross-covariance
+// (its gain rows for them are (P_ss H_s^T + P_sc H_c^T) S^-1); they are not
+// corrected: their covariance with every block not estimated (`o_idx` and
+// the considered blocks) is restored from P_hat.
+void RestoreConsideredCovariance(const ErrorStateLayout& layout,
+                                 const std::vector<int>& considered,
+                                 const std::vector<int>& o_idx,
+                                 const Eigen::MatrixXd& P_hat,
+                                 Eigen::MatrixXd* P_out) {
+  Eigen::MatrixXd& P = *P_out;
+  std::vector<int> not_estimated = o_idx;
+  for (int id : considered) {
+    const Segment b = layout.TeammateBlock(id);
+    for (int k = b.offset; k < b.end(); ++k) not_estimated.push_back(k);
+  }
+  for (int id : considered) {
+    const Segment b = layout.TeammateBlock(id);
+    for (int r = b.offset; r < b.end(); ++r) {
+      for (int k : not_estimated) P(r, k) = P(k, r) = P_hat(r, k);
+    }
+  }
+}
+
 }  // namespace
 
 
@@ -262,100 +527,35 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::Mat
   result.state = x_hat;
   result.covariance = P_hat;
   const ErrorStateLayout& layout = x_hat.layout();
-  const auto listed = [](const std::vector<int>* list, int id) {
-    return list != nullptr && std::find(list->begin(), list->end(), id) != list->end();
-  };
-  // The blocks in the solve (estimated and considered) in layout order; every
-  // listed id must be present, once, and in one list only.
+  // The blocks in the solve (estimated and considered) in layout order.
   std::vector<int> ids;
   std::vector<int> considered;
-  size_t num_estimated = 0;
-  for (int id : layout.teammate_ids()) {
-    const bool is_considered = listed(considered_teammates, id);
-    const bool is_estimated =
-        estimated_teammates == nullptr ? !is_considered : listed(estimated_teammates, id);
-    if (is_considered && is_estimated) {
-      result.status = Status::InvalidArgument("EsikfUpdate: teammate " + std::to_string(id) +
-                                              " is both estimated and considered");
-      return result;
-    }
-    if (is_considered) considered.push_back(id);
-    if (is_estimated) ++num_estimated;
-    if (is_considered || is_estimated) ids.push_back(id);
-  }
-  if ((estimated_teammates != nullptr && num_estimated != estimated_teammates->size()) ||
-      (considered_teammates != nullptr && considered.size() != considered_teammates->size())) {
-    result.status = Status::InvalidArgument(
-        "EsikfUpdate: estimated_teammates or considered_teammates names a teammate absent from "
-        "the state (or twice)");
-    return result;
-  }
+  result.status =
+      SelectTeammates(layout, estimated_teammates, considered_teammates, &ids, &considered);
+  if (!result.status.ok()) return result;
   if (P_hat.rows() != x_hat.Dim() || P_hat.cols() != x_hat.Dim() ||
       x_start.layout() != layout) {
     result.status = Status::InvalidArgument("EsikfUpdate: P_hat / x_start do not match x_hat");
     return result;
   }
   const std::vector<int> s_idx = SubsetIndices(layout, ids);
-  std::vector<int> o_idx;
-  for (int k = 0; k < x_hat.Dim(); ++k) {
-    if (std::find(s_idx.begin(), s_idx.end(), k) == s_idx.end()) o_idx.push_back(k);
-  }
+  const std::vector<int> o_idx = Complement(s_idx, x_hat.Dim());
   const Eigen::MatrixXd P_ss = Gather(P_hat, s_idx, s_idx);
   EsikfUpdateResult sub =
       RunAll(SubsetState(x_hat, ids), P_ss, SubsetState(x_start, ids), models, considered);
-  result.status = sub.status;
-  result.iterations = sub.iterations;
-  result.converged = sub.converged;
-  result.num_residual_blocks = sub.num_residual_blocks;
-  result.num_rejected_steps = sub.num_rejected_steps;
-  result.association_time_s = sub.association_time_s;
-  result.solve_time_s = sub.solve_time_s;
-  result.covariance_time_s = sub.covariance_time_s;
-  result.total_time_s = sub.total_time_s;
+  CopyRunStatistics(sub, &result);
   if (!sub.status.ok()) return result;
 
-  // Schmidt-Kalman: x_o and P_oo unchanged, P_os^+ = P_os (I - K H)^T in
-  // the tangent space at the solution, i.e. P_os P_ss^-1 J P_ss^+ with J =
-  // d(x (-) x_hat)/d dx at the solution (identity at x_hat; docs/esikf.md).
+  // Schmidt-Kalman: x_o and P_oo unchanged, P_os updated (and P_ss from the
+  // sub-update).
   const Clock::time_point t_cov = Clock::now();
   result.state.ego = sub.state.ego;
   for (int id : ids) result.state.teammate(id) = sub.state.teammate(id);
-  const SwarmState x_hat_s = SubsetState(x_hat, ids);
-  const Eigen::VectorXd e = sub.state.BoxMinus(x_hat_s);
-  Eigen::MatrixXd J = Eigen::MatrixXd::Identity(x_hat_s.Dim(), x_hat_s.Dim());
-  J.block<3, 3>(0, 0) = so3::RightJacobianInverse(e.head<3>());
-  for (int id : ids) {
-    const int o = x_hat_s.layout().TeammateRotation(id).offset;
-    J.block<3, 3>(o, o) = so3::RightJacobianInverse(e.segment<3>(o));
-  }
-  const Eigen::MatrixXd P_os = Gather(P_hat, o_idx, s_idx);
-  const Eigen::MatrixXd P_os_plus =
-      P_ss.llt().solve(P_os.transpose()).transpose() * J * sub.covariance;
-  Eigen::MatrixXd& P = result.covariance;
-  for (size_t r = 0; r < s_idx.size(); ++r) {
-    for (size_t c = 0; c < s_idx.size(); ++c) P(s_idx[r], s_idx[c]) = sub.covariance(r, c);
-  }
-  for (size_t r = 0; r < o_idx.size(); ++r) {
-    for (size_t c = 0; c < s_idx.size(); ++c) {
-      P(o_idx[r], s_idx[c]) = P(s_idx[c], o_idx[r]) = P_os_plus(r, c);
-    }
-  }
-  // Considered blocks: held at x_hat in the solve (RunAll), whose joint step
-  // gives the estimated blocks the Schmidt-Kalman gain and cross-covariance
-  // (its gain rows for them are (P_ss H_s^T + P_sc H_c^T) S^-1); they are not
-  // corrected: their covariance with every block not estimated is restored.
+  const Eigen::MatrixXd P_os_plus = SchmidtKalmanCrossCovariance(
+      SubsetState(x_hat, ids), sub.state, ids, Gather(P_hat, o_idx, s_idx), P_ss, sub.covariance);
+  ScatterCovariance(s_idx, o_idx, sub.covariance, P_os_plus, &result.covariance);
   if (!considered.empty()) {
-    std::vector<int> not_estimated = o_idx;
-    for (int id : considered) {
-      const Segment b = layout.TeammateBlock(id);
-      for (int k = b.offset; k < b.end(); ++k) not_estimated.push_back(k);
-    }
-    for (int id : considered) {
-      const Segment b = layout.TeammateBlock(id);
-      for (int r = b.offset; r < b.end(); ++r) {
-        for (int k : not_estimated) P(r, k) = P(k, r) = P_hat(r, k);
-      }
-    }
+    RestoreConsideredCovariance(layout, considered, o_idx, P_hat, &result.covariance);
   }
   result.covariance_time_s += SecondsSince(t_cov);
   return result;
@@ -375,92 +575,30 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
     result.total_time_s = SecondsSince(t_start);
     return result;
   };
-  if (const std::string invalid = options_.Validate(); !invalid.empty()) {
-    return fail(Status::InvalidArgument("EsikfUpdateOptions." + invalid));
-  }
-  if (x_start.layout() != x_hat.layout()) {
-    return fail(Status::InvalidArgument("EsikfUpdate: x_start and x_hat have different layouts"));
-  }
-  for (const MeasurementModel* m : models) {
-    if (m == nullptr) return fail(Status::InvalidArgument("EsikfUpdate: null measurement model"));
-  }
   Eigen::MatrixXd cholesky;
-  if (P_hat.rows() != x_hat.Dim() || !PriorFactor::CholeskyOfCovariance(P_hat, &cholesky)) {
-    return fail(Status::InvalidArgument(
-        "EsikfUpdate: P_hat must be a " + std::to_string(x_hat.Dim()) + "x" +
-        std::to_string(x_hat.Dim()) + " symmetric positive-definite matrix"));
+  if (Status invalid = CheckRunInputs(options_, x_hat, P_hat, x_start, models, &cholesky);
+      !invalid.ok()) {
+    return fail(std::move(invalid));
   }
 
-  // Everything the problem points to outlives it (declared before it).
-  EgoStateManifold ego_manifold;
-  GlobalExtrinsicManifold teammate_manifold;
-  PriorFactor prior(x_hat, std::move(cholesky));
   SwarmState x = x_start;
   const auto hold = [&x_hat, &held](SwarmState* at) {
     for (int id : held) at->teammate(id) = x_hat.teammate(id);
   };
   hold(&x);
-  ParameterBlocks blocks(x);
-
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.enable_fast_removal = true;
-  ceres::Problem problem(problem_options);
-  const std::vector<double*>& pointers = blocks.pointers();
-  problem.AddParameterBlock(pointers[0], EgoState::kAmbientSize, &ego_manifold);
-  for (size_t b = 1; b < pointers.size(); ++b) {
-    problem.AddParameterBlock(pointers[b], GlobalExtrinsic::kAmbientSize, &teammate_manifold);
-  }
-  problem.AddResidualBlock(&prior, nullptr, pointers);
-  std::vector<ceres::ResidualBlockId> measurement_blocks;
-  std::vector<ResidualTerm> terms;
-  std::vector<size_t> model_terms;  // terms of model k: [model_terms[k], model_terms[k + 1])
-  std::vector<double*> term_pointers;
+  UpdateProblem up(x_hat, std::move(cholesky), x);
+  ParameterBlocks& blocks = up.blocks;
 
   const ceres::Solver::Options solver_options = GaussNewtonStepOptions(options_.linear_solver);
   for (int it = 0; it < options_.max_iterations; ++it) {
-    // Drop last iteration's measurement blocks, re-linearize every model at x.
-    for (ceres::ResidualBlockId id : measurement_blocks) problem.RemoveResidualBlock(id);
-    measurement_blocks.clear();
-    terms.clear();
-    model_terms.assign(1, 0);
-    const Clock::time_point t_assoc = Clock::now();
-    for (MeasurementModel* model : models) {
-      const Status status = model->Linearize(x, &terms);
-      model_terms.push_back(terms.size());
-      if (!status.ok()) {
-        result.association_time_s += SecondsSince(t_assoc);
-        return fail(status.WithContext(std::string("EsikfUpdate: ") + model->name()));
-      }
+    if (Status status = Relinearize(models, x, &up, &result.association_time_s); !status.ok()) {
+      return fail(std::move(status));
     }
-    result.association_time_s += SecondsSince(t_assoc);
-    for (const ResidualTerm& term : terms) {
-      term_pointers.clear();
-      for (int block : term.blocks) {
-        if (block == kEgoBlock) {
-          term_pointers.push_back(pointers[0]);
-        } else if (x.layout().HasTeammate(block)) {
-          term_pointers.push_back(pointers[static_cast<size_t>(x.layout().SlotOf(block)) + 1]);
-        } else {
-          return fail(Status::InvalidArgument("EsikfUpdate: a residual block names teammate " +
-                                              std::to_string(block) +
-                                              ", absent from the estimated state"));
-        }
-      }
-      if (term.cost == nullptr ||
-          term.cost->parameter_block_sizes().size() != term_pointers.size()) {
-        return fail(Status::InvalidArgument(
-            "EsikfUpdate: a residual block's cost does not match its block list"));
-      }
-      measurement_blocks.push_back(problem.AddResidualBlock(
-          const_cast<ceres::CostFunction*>(term.cost), nullptr, term_pointers));
-    }
-    result.num_residual_blocks = static_cast<int>(measurement_blocks.size());
+    result.num_residual_blocks = static_cast<int>(up.measurements.ids.size());
 
     const Clock::time_point t_solve = Clock::now();
     ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &problem, &summary);
+    ceres::Solve(solver_options, &up.problem, &summary);
     result.solve_time_s += SecondsSince(t_solve);
     if (!summary.IsSolutionUsable()) {
       return fail(Status::Internal("EsikfUpdate: Ceres failed: " + summary.message));
@@ -482,29 +620,12 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
     }
   }
 
-  // Posterior (J^T J)^-1 at the final estimate: the tangent Jacobian of every
-  // residual block, columns in ErrorStateLayout order. The prior's in closed
-  // form; a model's through its fast path (AddInformation) when it has one,
-  // else from its blocks' Jacobians and the manifolds' PlusJacobian.
   const Clock::time_point t_cov = Clock::now();
   blocks.Write(x);
-  const Eigen::MatrixXd J_prior = prior.TangentJacobian(x);
-  Eigen::MatrixXd information = J_prior.transpose() * J_prior;
-  for (size_t k = 0; k < models.size(); ++k) {
-    if (models[k]->AddInformation(x, &information)) continue;
-    for (size_t t = model_terms[k]; t < model_terms[k + 1]; ++t) {
-      if (!AddTermInformation(terms[t], pointers, x.layout(), ego_manifold, teammate_manifold,
-                              &information)) {
-        return fail(Status::Internal("EsikfUpdate: Jacobian evaluation failed"));
-      }
-    }
+  Eigen::MatrixXd P;
+  if (Status status = PosteriorCovariance(up, x, models, &P); !status.ok()) {
+    return fail(std::move(status));
   }
-  const Eigen::LLT<Eigen::MatrixXd> llt(information);
-  if (llt.info() != Eigen::Success) {
-    return fail(Status::Internal("EsikfUpdate: posterior information is not positive definite"));
-  }
-  Eigen::MatrixXd P = llt.solve(Eigen::MatrixXd::Identity(x.Dim(), x.Dim()));
-  P = 0.5 * (P + P.transpose());
   result.covariance_time_s = SecondsSince(t_cov);
   result.state = std::move(x);
   result.covariance = std::move(P);

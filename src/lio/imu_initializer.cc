@@ -48,6 +48,93 @@ WindowStatistics ComputeStatistics(const std::deque<ImuSample>& window) {
   return s;
 }
 
+// The acceleration unit: configured, or (kAuto, *detected) from |mean a_m|
+// = raw_norm: ~1 -> g, ~g0 -> m/s^2, else FailedPrecondition.
+Status ResolveAccelerationUnit(AccelerationUnitSetting setting,
+                               double raw_norm,
+                               double g0,
+                               AccelerationUnit* unit,
+                               bool* detected) {
+  switch (setting) {
+    case AccelerationUnitSetting::kMetersPerSecondSquared:
+      *unit = AccelerationUnit::kMetersPerSecondSquared;
+      break;
+    case AccelerationUnitSetting::kStandardGravity:
+      *unit = AccelerationUnit::kStandardGravity;
+      break;
+    case AccelerationUnitSetting::kAuto:
+      *detected = true;
+      if (raw_norm >= kAutoMinRatio && raw_norm <= kAutoMaxRatio) {
+        *unit = AccelerationUnit::kStandardGravity;
+      } else if (raw_norm >= kAutoMinRatio * g0 && raw_norm <= kAutoMaxRatio * g0) {
+        *unit = AccelerationUnit::kMetersPerSecondSquared;
+      } else {
+        std::ostringstream os;
+        os << "imu initializer: cannot detect the acceleration unit: |mean acc| = " << raw_norm
+           << " is neither ~1 (g, accepted [" << kAutoMinRatio << ", " << kAutoMaxRatio
+           << "]) nor ~" << g0 << " (m/s^2, accepted [" << kAutoMinRatio * g0 << ", "
+           << kAutoMaxRatio * g0 << "])";
+        return Status::FailedPrecondition(os.str());
+      }
+      break;
+  }
+  return Status::Ok();
+}
+
+// Where the reported mean acceleration (raw, norm raw_norm) points relative
+// to up_axis: up, down (within max_up_axis_angle_deg) or undetermined, and
+// its angle from up_axis [deg] (0 without an up_axis).
+void ReportedDirection(const ImuInitializerOptions& options,
+                       const Eigen::Vector3d& mean_accel,
+                       double raw_norm,
+                       SpecificForceDirection* direction,
+                       double* angle_deg) {
+  const Eigen::Vector3d up = UpAxisVector(options.up_axis);
+  if (options.up_axis != ImuUpAxis::kNone && raw_norm > 0.0) {
+    const double c = std::clamp(mean_accel.dot(up) / raw_norm, -1.0, 1.0);
+    *angle_deg = std::acos(c) * 180.0 / M_PI;
+    if (*angle_deg <= options.max_up_axis_angle_deg) {
+      *direction = SpecificForceDirection::kUp;
+    } else if (*angle_deg >= 180.0 - options.max_up_axis_angle_deg) {
+      *direction = SpecificForceDirection::kDown;
+    }
+  }
+}
+
+// The accelerometer sign: *sign is the configured one (0 = auto: detected
+// from the direction, +1 when undetermined); *sign_warning explains an
+// undetermined auto sign or a direction that contradicts the configured one.
+void ResolveSign(const ImuInitializerOptions& options,
+                 SpecificForceDirection direction,
+                 double angle_deg,
+                 int* sign,
+                 std::string* sign_warning) {
+  const bool sign_detected = *sign == 0;
+  std::ostringstream os;
+  os << "the mean acceleration at rest points " << config::EnumToString(direction) << " ("
+     << angle_deg << " deg from up_axis " << config::EnumToString(options.up_axis) << ")";
+  const std::string seen = os.str();
+  if (sign_detected) {
+    if (direction == SpecificForceDirection::kUndetermined) {
+      *sign = 1;
+      *sign_warning = seen + ": cannot tell the accelerometer sign, assumed +1; set "
+                             "imu_init.acceleration_sign (+1 or -1) or imu_init.up_axis";
+    } else {
+      *sign = direction == SpecificForceDirection::kDown ? -1 : 1;
+    }
+  } else if (direction == SpecificForceDirection::kDown && *sign == 1) {
+    *sign_warning = seen + ", gravity comes out opposite to the configured sign: the driver "
+                           "reports -(specific force) (or the IMU is mounted with up_axis "
+                           "down); set imu_init.acceleration_sign: -1 (or 0 = auto; replay "
+                           "manifest: odometry: {imu_init: {acceleration_sign: 0}}), or "
+                           "imu_init.up_axis to the IMU's up axis";
+  } else if (direction == SpecificForceDirection::kUp && *sign == -1) {
+    *sign_warning = seen + ", gravity comes out opposite to the configured sign -1: the driver "
+                           "reports the specific force; set imu_init.acceleration_sign: 1 (or "
+                           "0 = auto), or imu_init.up_axis to the IMU's up axis";
+  }
+}
+
 }  // namespace
 
 Eigen::Vector3d UpAxisVector(ImuUpAxis axis) {
@@ -173,73 +260,19 @@ Status ImuInitializer::DetermineUnitAndSign(const Eigen::Vector3d& mean_accel,
   // 1. Unit: configured, or detected from |mean a_m| (~1 -> g, ~9.8 -> m/s^2).
   AccelerationUnit unit = AccelerationUnit::kMetersPerSecondSquared;
   bool detected = false;
-  switch (options_.acceleration_unit) {
-    case AccelerationUnitSetting::kMetersPerSecondSquared:
-      unit = AccelerationUnit::kMetersPerSecondSquared;
-      break;
-    case AccelerationUnitSetting::kStandardGravity:
-      unit = AccelerationUnit::kStandardGravity;
-      break;
-    case AccelerationUnitSetting::kAuto:
-      detected = true;
-      if (raw_norm >= kAutoMinRatio && raw_norm <= kAutoMaxRatio) {
-        unit = AccelerationUnit::kStandardGravity;
-      } else if (raw_norm >= kAutoMinRatio * g0 && raw_norm <= kAutoMaxRatio * g0) {
-        unit = AccelerationUnit::kMetersPerSecondSquared;
-      } else {
-        std::ostringstream os;
-        os << "imu initializer: cannot detect the acceleration unit: |mean acc| = " << raw_norm
-           << " is neither ~1 (g, accepted [" << kAutoMinRatio << ", " << kAutoMaxRatio
-           << "]) nor ~" << g0 << " (m/s^2, accepted [" << kAutoMinRatio * g0 << ", "
-           << kAutoMaxRatio * g0 << "])";
-        return Status::FailedPrecondition(os.str());
-      }
-      break;
-  }
+  SWARMLIO_RETURN_IF_ERROR(
+      ResolveAccelerationUnit(options_.acceleration_unit, raw_norm, g0, &unit, &detected));
   const double unit_factor = unit == AccelerationUnit::kStandardGravity ? g0 : 1.0;
 
   // 1b. Sign: the direction of the reported mean acceleration relative to
   // up_axis (a normal accelerometer at rest reports the specific force, up).
-  const Eigen::Vector3d up = UpAxisVector(options_.up_axis);
   SpecificForceDirection direction = SpecificForceDirection::kUndetermined;
   double angle_deg = 0.0;
-  if (options_.up_axis != ImuUpAxis::kNone && raw_norm > 0.0) {
-    const double c = std::clamp(mean_accel.dot(up) / raw_norm, -1.0, 1.0);
-    angle_deg = std::acos(c) * 180.0 / M_PI;
-    if (angle_deg <= options_.max_up_axis_angle_deg) {
-      direction = SpecificForceDirection::kUp;
-    } else if (angle_deg >= 180.0 - options_.max_up_axis_angle_deg) {
-      direction = SpecificForceDirection::kDown;
-    }
-  }
+  ReportedDirection(options_, mean_accel, raw_norm, &direction, &angle_deg);
   int sign = options_.acceleration_sign;
   const bool sign_detected = sign == 0;
   std::string sign_warning;
-  {
-    std::ostringstream os;
-    os << "the mean acceleration at rest points " << config::EnumToString(direction) << " ("
-       << angle_deg << " deg from up_axis " << config::EnumToString(options_.up_axis) << ")";
-    const std::string seen = os.str();
-    if (sign_detected) {
-      if (direction == SpecificForceDirection::kUndetermined) {
-        sign = 1;
-        sign_warning = seen + ": cannot tell the accelerometer sign, assumed +1; set "
-                              "imu_init.acceleration_sign (+1 or -1) or imu_init.up_axis";
-      } else {
-        sign = direction == SpecificForceDirection::kDown ? -1 : 1;
-      }
-    } else if (direction == SpecificForceDirection::kDown && sign == 1) {
-      sign_warning = seen + ", gravity comes out opposite to the configured sign: the driver "
-                            "reports -(specific force) (or the IMU is mounted with up_axis "
-                            "down); set imu_init.acceleration_sign: -1 (or 0 = auto; replay "
-                            "manifest: odometry: {imu_init: {acceleration_sign: 0}}), or "
-                            "imu_init.up_axis to the IMU's up axis";
-    } else if (direction == SpecificForceDirection::kUp && sign == -1) {
-      sign_warning = seen + ", gravity comes out opposite to the configured sign -1: the driver "
-                            "reports the specific force; set imu_init.acceleration_sign: 1 (or "
-                            "0 = auto), or imu_init.up_axis to the IMU's up axis";
-    }
-  }
+  ResolveSign(options_, direction, angle_deg, &sign, &sign_warning);
   out->unit = unit;
   out->detected = detected;
   out->unit_factor = unit_factor;

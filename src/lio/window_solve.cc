@@ -157,6 +157,140 @@ Status WindowSmoother::Impl::NewestCovariance(Eigen::MatrixXd* P) const {
   return Status::Ok();
 }
 
+void WindowSmoother::Impl::SelectPlaneScans(std::vector<WindowScan*>* active,
+                                            std::vector<WindowScan*>* associated) {
+  if (map->empty()) return;
+  for (auto& s : scans) {
+    if (!s->use_planes || s->in_map) continue;
+    active->push_back(s.get());
+    // The older scans keep their correspondences (re-linearized) unless
+    // every scan is re-associated (window.reassociate_all_scans).
+    if (options.reassociate_all_scans || !s->updated || s.get() == scans.back().get()) {
+      s->associator->Reset(&s->points_in_b);  // the map changed since the last solve
+      associated->push_back(s.get());
+    }
+  }
+}
+
+int WindowSmoother::Impl::AddResidualBlocks(const std::vector<WindowScan*>& active,
+                                            ceres::Problem* problem) {
+  for (auto& s : scans) {
+    problem->AddParameterBlock(s->ego.data(), EgoState::kAmbientSize, &ego_manifold);
+  }
+  for (auto& t : teammates) {
+    problem->AddParameterBlock(t->x.data(), GlobalExtrinsic::kAmbientSize, &teammate_manifold);
+  }
+  if (prior.factor != nullptr) {
+    problem->AddResidualBlock(prior.factor.get(), nullptr, prior.system.parameter_blocks);
+  }
+  for (size_t i = 1; i < scans.size(); ++i) {
+    problem->AddResidualBlock(scans[i]->imu_factor.get(), nullptr, scans[i - 1]->ego.data(),
+                              scans[i]->ego.data());
+  }
+  for (WindowScan* s : active) problem->AddResidualBlock(&s->compressed, nullptr, s->ego.data());
+  int num_measurement_blocks = 0;
+  for (auto& s : scans) {
+    for (const OwnedResidualTerm& term : s->observations) {
+      std::vector<double*> blocks;
+      for (int b : term.blocks) blocks.push_back(BlockOf(*s, b));
+      problem->AddResidualBlock(term.cost.get(), nullptr, blocks);
+      ++num_measurement_blocks;
+    }
+  }
+  num_measurement_blocks += static_cast<int>(active.size());
+  return num_measurement_blocks;
+}
+
+Status WindowSmoother::Impl::Reassociate(const std::vector<WindowScan*>& associated,
+                                         const std::vector<WindowScan*>& active) {
+  Status status;
+  for (WindowScan* s : associated) {
+    SwarmState at;
+    at.ego = s->State();
+    status = s->associator->Associate(at, &s->correspondences);
+    if (!status.ok()) break;
+    s->stats = s->associator->stats();
+  }
+  for (WindowScan* s : active) s->RefreshPlanes();
+  return status;
+}
+
+bool WindowSmoother::Impl::StepIsSmall(const std::vector<double>& start) const {
+  // Converged when every state's step is below the filter's thresholds.
+  bool small = true;
+  size_t offset = 0;
+  for (const auto& s : scans) {
+    const EgoState old_x = EgoState::FromParameters(start.data() + offset);
+    const auto dx = s->State().BoxMinus(old_x);
+    small = small && dx.segment<3>(ErrorStateLayout::kRotation.offset).norm() <
+                         update.convergence_rotation_rad;
+    small = small && dx.segment<3>(ErrorStateLayout::kPosition.offset).norm() <
+                         update.convergence_translation_m;
+    offset += EgoState::kAmbientSize;
+  }
+  for (const auto& t : teammates) {
+    const GlobalExtrinsic old_T = GlobalExtrinsic::FromParameters(start.data() + offset);
+    const auto dx = GlobalExtrinsic::FromParameters(t->x.data()).BoxMinus(old_T);
+    small = small && dx.head<3>().norm() < update.convergence_rotation_rad &&
+            dx.tail<3>().norm() < update.convergence_translation_m;
+    offset += GlobalExtrinsic::kAmbientSize;
+  }
+  return small;
+}
+
+void WindowSmoother::Impl::Iterate(const std::vector<WindowScan*>& active,
+                                   const std::vector<WindowScan*>& associated,
+                                   ceres::Problem* problem,
+                                   WindowSolveResult* result) {
+  ceres::Solver::Options solver_options = GaussNewtonStepOptions(ToCeres(options.linear_solver));
+  solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    const Clock::time_point t_assoc = Clock::now();
+    result->status = Reassociate(associated, active);
+    result->association_s += SecondsSince(t_assoc);
+    if (!result->status.ok()) break;
+    const std::vector<double> start = Values();
+    const Clock::time_point t_solve = Clock::now();
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, problem, &summary);
+    result->solve_s += SecondsSince(t_solve);
+    if (!summary.IsSolutionUsable()) {
+      result->status = Status::Internal("window: Ceres failed: " + summary.message);
+      break;
+    }
+    ++result->iterations;
+    result->num_rejected_steps += summary.num_unsuccessful_steps;
+    if (summary.num_unsuccessful_steps > 0) break;
+    if (StepIsSmall(start)) {
+      result->converged = true;
+      break;
+    }
+  }
+}
+
+void WindowSmoother::Impl::FinishIterations(const std::vector<double>& before,
+                                            const std::vector<WindowScan*>& active,
+                                            WindowSolveResult* result) {
+  const std::vector<double> after = Values();
+  const bool finite =
+      std::all_of(after.begin(), after.end(), [](double v) { return std::isfinite(v); });
+  if (result->status.ok() && !finite) {
+    result->status = Status::Internal("window: non-finite solution");
+  }
+  if (!result->status.ok()) Restore(before);
+  for (WindowScan* s : active) {
+    if (result->status.ok()) s->updated = true;
+    s->RefreshPlanes();  // at the final (or restored) value, for covariance and marginalization
+  }
+  WindowScan& newest = *scans.back();
+  const bool newest_active = std::find(active.begin(), active.end(), &newest) != active.end();
+  if (newest_active) {
+    result->updated = result->status.ok();
+    result->num_correspondences = static_cast<int>(newest.correspondences.size());
+    result->newest_stats = newest.stats;
+  }
+}
+
 WindowSolveResult WindowSmoother::Solve() {
   Impl& im = *impl_;
   WindowSolveResult result;
@@ -168,117 +302,18 @@ WindowSolveResult WindowSmoother::Solve() {
   im.ReintegrateImu();
   std::vector<WindowScan*> active;      // scans with point-to-plane terms
   std::vector<WindowScan*> associated;  // of those, the ones re-associated at each iteration
-  if (!im.map->empty()) {
-    for (auto& s : im.scans) {
-      if (!s->use_planes || s->in_map) continue;
-      active.push_back(s.get());
-      // The older scans keep their correspondences (re-linearized) unless
-      // every scan is re-associated (window.reassociate_all_scans).
-      if (im.options.reassociate_all_scans || !s->updated || s.get() == im.scans.back().get()) {
-        s->associator->Reset(&s->points_in_b);  // the map changed since the last solve
-        associated.push_back(s.get());
-      }
-    }
-  }
+  im.SelectPlaneScans(&active, &associated);
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  for (auto& s : im.scans) {
-    problem.AddParameterBlock(s->ego.data(), EgoState::kAmbientSize, &im.ego_manifold);
-  }
-  for (auto& t : im.teammates) {
-    problem.AddParameterBlock(t->x.data(), GlobalExtrinsic::kAmbientSize, &im.teammate_manifold);
-  }
-  if (im.prior.factor != nullptr) {
-    problem.AddResidualBlock(im.prior.factor.get(), nullptr, im.prior.system.parameter_blocks);
-  }
-  for (size_t i = 1; i < im.scans.size(); ++i) {
-    problem.AddResidualBlock(im.scans[i]->imu_factor.get(), nullptr, im.scans[i - 1]->ego.data(),
-                             im.scans[i]->ego.data());
-  }
-  for (WindowScan* s : active) problem.AddResidualBlock(&s->compressed, nullptr, s->ego.data());
-  for (auto& s : im.scans) {
-    for (const OwnedResidualTerm& term : s->observations) {
-      std::vector<double*> blocks;
-      for (int b : term.blocks) blocks.push_back(im.BlockOf(*s, b));
-      problem.AddResidualBlock(term.cost.get(), nullptr, blocks);
-      ++result.num_residual_blocks;
-    }
-  }
-  result.num_residual_blocks += static_cast<int>(active.size());
+  result.num_residual_blocks = im.AddResidualBlocks(active, &problem);
   result.build_s = SecondsSince(t_build);
 
   if (!active.empty()) {
     const std::vector<double> before = im.Values();
-    ceres::Solver::Options solver_options = GaussNewtonStepOptions(ToCeres(im.options.linear_solver));
-    solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
-    for (int it = 0; it < im.options.max_iterations; ++it) {
-      const Clock::time_point t_assoc = Clock::now();
-      for (WindowScan* s : associated) {
-        SwarmState at;
-        at.ego = s->State();
-        result.status = s->associator->Associate(at, &s->correspondences);
-        if (!result.status.ok()) break;
-        s->stats = s->associator->stats();
-      }
-      for (WindowScan* s : active) s->RefreshPlanes();
-      result.association_s += SecondsSince(t_assoc);
-      if (!result.status.ok()) break;
-      const std::vector<double> start = im.Values();
-      const Clock::time_point t_solve = Clock::now();
-      ceres::Solver::Summary summary;
-      ceres::Solve(solver_options, &problem, &summary);
-      result.solve_s += SecondsSince(t_solve);
-      if (!summary.IsSolutionUsable()) {
-        result.status = Status::Internal("window: Ceres failed: " + summary.message);
-        break;
-      }
-      ++result.iterations;
-      result.num_rejected_steps += summary.num_unsuccessful_steps;
-      if (summary.num_unsuccessful_steps > 0) break;
-      // Converged when every state's step is below the filter's thresholds.
-      bool small = true;
-      size_t offset = 0;
-      for (const auto& s : im.scans) {
-        const EgoState old_x = EgoState::FromParameters(start.data() + offset);
-        const auto dx = s->State().BoxMinus(old_x);
-        small = small && dx.segment<3>(ErrorStateLayout::kRotation.offset).norm() <
-                             im.update.convergence_rotation_rad;
-        small = small && dx.segment<3>(ErrorStateLayout::kPosition.offset).norm() <
-                             im.update.convergence_translation_m;
-        offset += EgoState::kAmbientSize;
-      }
-      for (const auto& t : im.teammates) {
-        const GlobalExtrinsic old_T = GlobalExtrinsic::FromParameters(start.data() + offset);
-        const auto dx = GlobalExtrinsic::FromParameters(t->x.data()).BoxMinus(old_T);
-        small = small && dx.head<3>().norm() < im.update.convergence_rotation_rad &&
-                dx.tail<3>().norm() < im.update.convergence_translation_m;
-        offset += GlobalExtrinsic::kAmbientSize;
-      }
-      if (small) {
-        result.converged = true;
-        break;
-      }
-    }
-    const std::vector<double> after = im.Values();
-    const bool finite = std::all_of(after.begin(), after.end(),
-                                    [](double v) { return std::isfinite(v); });
-    if (result.status.ok() && !finite) {
-      result.status = Status::Internal("window: non-finite solution");
-    }
-    if (!result.status.ok()) im.Restore(before);
-    for (WindowScan* s : active) {
-      if (result.status.ok()) s->updated = true;
-      s->RefreshPlanes();  // at the final (or restored) value, for covariance and marginalization
-    }
-    WindowScan& newest = *im.scans.back();
-    const bool newest_active = std::find(active.begin(), active.end(), &newest) != active.end();
-    if (newest_active) {
-      result.updated = result.status.ok();
-      result.num_correspondences = static_cast<int>(newest.correspondences.size());
-      result.newest_stats = newest.stats;
-    }
+    im.Iterate(active, associated, &problem, &result);
+    im.FinishIterations(before, active, &result);
   }
 
   const Clock::time_point t_cov = Clock::now();

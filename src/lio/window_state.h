@@ -5,6 +5,7 @@
 #pragma once
 
 #include <ceres/manifold.h>
+#include <ceres/problem.h>
 
 #include <algorithm>
 #include <array>
@@ -131,6 +132,29 @@ struct WindowSmoother::Impl {
   Status AddState(WindowStateInput* input, std::vector<LeavingScan>* leaving,
                   std::string* model_error);
   void ReintegrateImu();
+  // Solve, step by step (window_solve.cc). The scans with point-to-plane
+  // terms (`active`) and, of those, the ones re-associated at each
+  // iteration (their associators reset: the map changed).
+  void SelectPlaneScans(std::vector<WindowScan*>* active, std::vector<WindowScan*>* associated);
+  // The parameter blocks and every residual block of the window; returns
+  // the number of measurement blocks (planes, observations).
+  int AddResidualBlocks(const std::vector<WindowScan*>& active, ceres::Problem* problem);
+  // Re-associates `associated` at their current values and re-linearizes
+  // the planes of every active scan; the first association error.
+  Status Reassociate(const std::vector<WindowScan*>& associated,
+                     const std::vector<WindowScan*>& active);
+  // Every state's step from `start` (Values()) below the update's thresholds.
+  bool StepIsSmall(const std::vector<double>& start) const;
+  // The Gauss-Newton iterations with re-association.
+  void Iterate(const std::vector<WindowScan*>& active,
+               const std::vector<WindowScan*>& associated,
+               ceres::Problem* problem,
+               WindowSolveResult* result);
+  // After the iterations: restores `before` on failure (or a non-finite
+  // solution), re-linearizes the active planes, reports the newest scan's.
+  void FinishIterations(const std::vector<double>& before,
+                        const std::vector<WindowScan*>& active,
+                        WindowSolveResult* result);
   Status NewestCovariance(Eigen::MatrixXd* P) const;
   void ReadState(SwarmState* x) const;
   std::vector<double> Values() const;

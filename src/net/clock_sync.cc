@@ -37,6 +37,111 @@ int64_t SecondsToNs(double s) { return std::llround(s * kNsPerS); }
 bool Sub(int64_t a, int64_t b, int64_t* out) { return !__builtin_sub_overflow(a, b, out); }
 bool Add(int64_t a, int64_t b, int64_t* out) { return !__builtin_add_overflow(a, b, out); }
 
+// Round-trip statistics of the exchanges a fit uses.
+struct DelayStatistics {
+  int64_t min_delay_ns = 0;    // their minimum round trip
+  double s0 = 0.0;             // the noise of an undelayed exchange [ns]
+  double delay_noise = 0.0;    // half the round trips' robust std [ns]
+  double median_excess = 0.0;  // half the median round trip's excess over the minimum [ns]
+};
+
+// Delay statistics. s0, the noise of an undelayed exchange, is the gap
+// between the minimum and the lower quartile of the round trips: a
+// symmetric jitter gives a wide gap, so the weights stay nearly uniform; a
+// tight core with a queueing tail gives a small gap, so the tail is
+// down-weighted by its excess delay. (A quartile rather than the median, so
+// that the core wins while up to 3/4 of the exchanges are delayed.) Never
+// below floor_ns, the timestamp noise.
+DelayStatistics ComputeDelayStatistics(const std::vector<TimeSyncSample>& used, double floor_ns) {
+  const size_t n = used.size();
+  std::vector<int64_t> delays;
+  delays.reserve(n);
+  for (const TimeSyncSample& s : used) delays.push_back(s.delay_ns);
+  std::sort(delays.begin(), delays.end());
+  DelayStatistics stats;
+  const int64_t min_delay_ns = delays.front();  // of the exchanges used
+  stats.min_delay_ns = min_delay_ns;
+  stats.s0 = std::max(floor_ns, static_cast<double>(delays[n / 4] - min_delay_ns));
+  // For a symmetric jitter an exchange's error has half the round trip's
+  // std: a second, independent guess of the noise (robust: MAD).
+  std::vector<double> deviations(n);
+  for (size_t i = 0; i < n; ++i) {
+    deviations[i] = std::abs(static_cast<double>(delays[i] - delays[n / 2]));
+  }
+  std::nth_element(deviations.begin(), deviations.begin() + static_cast<std::ptrdiff_t>(n / 2),
+                   deviations.end());
+  stats.delay_noise = 0.5 * kMadToSigma * deviations[n / 2];
+  stats.median_excess = 0.5 * static_cast<double>(delays[n / 2] - min_delay_ns);
+  return stats;
+}
+
+// The samples of the line fit: x [s] and y [ns] relative to the base time
+// and offset, the excess delay [ns] and the weights.
+struct FitSamples {
+  std::vector<double> xs, ys, excess, ws;
+};
+
+// Weighted least squares of y = a + b x with the drift prior; `scale`
+// multiplies every sample's variance.
+// (The prior keeps the normal matrix regular: the fit always succeeds.)
+// Reweights samples->ws.
+internal::WeightedLine FitRobustLine(FitSamples* samples,
+                                     const DelayStatistics& delays,
+                                     double prior_info) {
+  const std::vector<double>& xs = samples->xs;
+  const std::vector<double>& ys = samples->ys;
+  const std::vector<double>& excess = samples->excess;
+  std::vector<double>& ws = samples->ws;
+  const size_t n = xs.size();
+  const double s0 = delays.s0;
+  std::vector<double> abs_residuals(n);
+  internal::WeightedLine line;
+  double &a = line.a, &b = line.b;
+  auto solve = [&](double scale) {
+    internal::FitWeightedLine(xs, ys, ws, scale, prior_info, &line);
+  };
+  solve(1.0);
+  // Iteratively reweighted: a sample's noise is the residual scale sr plus
+  // its excess delay, and a Huber weight tempers samples beyond kHuberK of
+  // that. sr is measured on the core (the half of the exchanges with the
+  // least excess delay), never below s0: with a symmetric jitter the
+  // minimum-delay exchange is no better than the others, and this keeps it
+  // from dominating; with a queueing tail the core is the undelayed part.
+  const double median_excess = delays.median_excess;
+  double sr = s0;
+  for (int iteration = 0; n >= 3 && iteration < kReweightIterations; ++iteration) {
+    abs_residuals.clear();
+    for (size_t i = 0; i < n; ++i) {
+      if (excess[i] <= median_excess) abs_residuals.push_back(std::abs(ys[i] - a - b * xs[i]));
+    }
+    const size_t core = abs_residuals.size();  // >= n / 2 + 1
+    std::nth_element(abs_residuals.begin(),
+                     abs_residuals.begin() + static_cast<std::ptrdiff_t>(core / 2),
+                     abs_residuals.end());
+    // Residuals of a 2-parameter fit are smaller than the noise by about sqrt((n-2)/n).
+    const double correction = std::sqrt(static_cast<double>(n) / static_cast<double>(n - 2));
+    sr = std::max(s0, kMadToSigma * correction * abs_residuals[core / 2]);
+    for (size_t i = 0; i < n; ++i) {
+      const double variance = sr * sr + excess[i] * excess[i];
+      const double u = std::abs(ys[i] - a - b * xs[i]) / std::sqrt(variance);
+      ws[i] = (u > kHuberK ? kHuberK / u : 1.0) / variance;
+    }
+    solve(1.0);
+  }
+  double chi2 = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double r = ys[i] - a - b * xs[i];
+    chi2 += ws[i] * r * r;
+  }
+  // The variance scale: chi^2 / dof, shrunk towards what the delay spread
+  // suggests (never below the model), so that a few exchanges that happen to
+  // line up do not claim a precision (and a drift) they cannot have.
+  const double dof = static_cast<double>(n) - 1.0;  // 2 parameters, the prior counts as one datum
+  const double prior_ratio = std::max(1.0, (delays.delay_noise * delays.delay_noise) / (sr * sr));
+  solve((chi2 + kScalePseudoDof * prior_ratio) / (dof + kScalePseudoDof));
+  return line;
+}
+
 }  // namespace
 
 std::string ClockSyncOptions::Validate() const {
@@ -117,7 +222,7 @@ ClockOffsetEstimator::Verdict ClockOffsetEstimator::AddSample(const TimeSyncSamp
   return Verdict::kAdded;
 }
 
-void ClockOffsetEstimator::Fit() {
+bool ClockOffsetEstimator::TrimWindow() {
   // Window: newest local time, then drop by count and age.
   while (static_cast<int>(samples_.size()) > options_.window_samples) samples_.pop_front();
   int64_t newest = std::numeric_limits<int64_t>::min();
@@ -127,14 +232,15 @@ void ClockOffsetEstimator::Fit() {
       std::remove_if(samples_.begin(), samples_.end(),
                      [&](const TimeSyncSample& s) { return newest - s.local_mid_ns > window_ns; }),
       samples_.end());
-  if (samples_.empty()) return;
+  if (samples_.empty()) return false;
   base_time_ns_ = newest;
   base_offset_ns_ = samples_.back().offset_ns;
-  const double prior_b = options_.drift_prior_ppm * 1e3;  // [ns/s]
-  const double prior_info = 1.0 / (prior_b * prior_b);
   min_delay_ns_ = std::numeric_limits<int64_t>::max();
   for (const TimeSyncSample& s : samples_) min_delay_ns_ = std::min(min_delay_ns_, s.delay_ns);
+  return true;
+}
 
+std::vector<TimeSyncSample> ClockOffsetEstimator::SamplesToFit(double prior_info) const {
   // Exchanges that no offset explains (a fast lane, as netem's reorder: one
   // leg skipped the path delay) are left out (src/net/offset_outliers.h).
   std::vector<TimeSyncSample> used(samples_.begin(), samples_.end());
@@ -154,86 +260,32 @@ void ClockOffsetEstimator::Fit() {
     }
     if (used.size() < 3) used.assign(samples_.begin(), samples_.end());
   }
+  return used;
+}
+
+void ClockOffsetEstimator::Fit() {
+  if (!TrimWindow()) return;
+  const double prior_b = options_.drift_prior_ppm * 1e3;  // [ns/s]
+  const double prior_info = 1.0 / (prior_b * prior_b);
+  const std::vector<TimeSyncSample> used = SamplesToFit(prior_info);
   const size_t n = used.size();
+  const DelayStatistics delays = ComputeDelayStatistics(used, options_.timestamp_noise_s * kNsPerS);
 
-  // Delay statistics. s0, the noise of an undelayed exchange, is the gap
-  // between the minimum and the lower quartile of the round trips: a
-  // symmetric jitter gives a wide gap, so the weights stay nearly uniform; a
-  // tight core with a queueing tail gives a small gap, so the tail is
-  // down-weighted by its excess delay. (A quartile rather than the median, so
-  // that the core wins while up to 3/4 of the exchanges are delayed.)
-  std::vector<int64_t> delays;
-  delays.reserve(n);
-  for (const TimeSyncSample& s : used) delays.push_back(s.delay_ns);
-  std::sort(delays.begin(), delays.end());
-  const int64_t min_delay_ns = delays.front();  // of the exchanges used
-  const double s0 = std::max(options_.timestamp_noise_s * kNsPerS,
-                             static_cast<double>(delays[n / 4] - min_delay_ns));
-  // For a symmetric jitter an exchange's error has half the round trip's
-  // std: a second, independent guess of the noise (robust: MAD).
-  std::vector<double> deviations(n);
-  for (size_t i = 0; i < n; ++i) {
-    deviations[i] = std::abs(static_cast<double>(delays[i] - delays[n / 2]));
-  }
-  std::nth_element(deviations.begin(), deviations.begin() + static_cast<std::ptrdiff_t>(n / 2),
-                   deviations.end());
-  const double delay_noise = 0.5 * kMadToSigma * deviations[n / 2];
-
-  std::vector<double> xs(n), ys(n), excess(n), ws(n), abs_residuals(n);
+  FitSamples samples;
+  samples.xs.resize(n);
+  samples.ys.resize(n);
+  samples.excess.resize(n);
+  samples.ws.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const TimeSyncSample& s = used[i];
-    xs[i] = static_cast<double>(s.local_mid_ns - base_time_ns_) / kNsPerS;  // [s], <= 0
-    ys[i] = static_cast<double>(s.offset_ns - base_offset_ns_);             // [ns]
-    excess[i] = 0.5 * static_cast<double>(s.delay_ns - min_delay_ns);       // [ns]
-    ws[i] = 1.0 / (s0 * s0 + excess[i] * excess[i]);
+    samples.xs[i] = static_cast<double>(s.local_mid_ns - base_time_ns_) / kNsPerS;    // [s], <= 0
+    samples.ys[i] = static_cast<double>(s.offset_ns - base_offset_ns_);               // [ns]
+    samples.excess[i] = 0.5 * static_cast<double>(s.delay_ns - delays.min_delay_ns);  // [ns]
+    samples.ws[i] = 1.0 / (delays.s0 * delays.s0 + samples.excess[i] * samples.excess[i]);
   }
-  // Weighted least squares of y = a + b x with the drift prior; `scale`
-  // multiplies every sample's variance.
-  // (The prior keeps the normal matrix regular: the fit always succeeds.)
-  internal::WeightedLine line;
-  double &a = line.a, &b = line.b;
-  auto solve = [&](double scale) { internal::FitWeightedLine(xs, ys, ws, scale, prior_info, &line); };
-  solve(1.0);
-  // Iteratively reweighted: a sample's noise is the residual scale sr plus
-  // its excess delay, and a Huber weight tempers samples beyond kHuberK of
-  // that. sr is measured on the core (the half of the exchanges with the
-  // least excess delay), never below s0: with a symmetric jitter the
-  // minimum-delay exchange is no better than the others, and this keeps it
-  // from dominating; with a queueing tail the core is the undelayed part.
-  const double median_excess = 0.5 * static_cast<double>(delays[n / 2] - min_delay_ns);
-  double sr = s0;
-  for (int iteration = 0; n >= 3 && iteration < kReweightIterations; ++iteration) {
-    abs_residuals.clear();
-    for (size_t i = 0; i < n; ++i) {
-      if (excess[i] <= median_excess) abs_residuals.push_back(std::abs(ys[i] - a - b * xs[i]));
-    }
-    const size_t core = abs_residuals.size();  // >= n / 2 + 1
-    std::nth_element(abs_residuals.begin(),
-                     abs_residuals.begin() + static_cast<std::ptrdiff_t>(core / 2),
-                     abs_residuals.end());
-    // Residuals of a 2-parameter fit are smaller than the noise by about sqrt((n-2)/n).
-    const double correction = std::sqrt(static_cast<double>(n) / static_cast<double>(n - 2));
-    sr = std::max(s0, kMadToSigma * correction * abs_residuals[core / 2]);
-    for (size_t i = 0; i < n; ++i) {
-      const double variance = sr * sr + excess[i] * excess[i];
-      const double u = std::abs(ys[i] - a - b * xs[i]) / std::sqrt(variance);
-      ws[i] = (u > kHuberK ? kHuberK / u : 1.0) / variance;
-    }
-    solve(1.0);
-  }
-  double chi2 = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const double r = ys[i] - a - b * xs[i];
-    chi2 += ws[i] * r * r;
-  }
-  // The variance scale: chi^2 / dof, shrunk towards what the delay spread
-  // suggests (never below the model), so that a few exchanges that happen to
-  // line up do not claim a precision (and a drift) they cannot have.
-  const double dof = static_cast<double>(n) - 1.0;  // 2 parameters, the prior counts as one datum
-  const double prior_ratio = std::max(1.0, (delay_noise * delay_noise) / (sr * sr));
-  solve((chi2 + kScalePseudoDof * prior_ratio) / (dof + kScalePseudoDof));
-  a_ns_ = a;
-  b_ns_per_s_ = b;
+  const internal::WeightedLine line = FitRobustLine(&samples, delays, prior_info);
+  a_ns_ = line.a;
+  b_ns_per_s_ = line.b;
   cov_aa_ = line.caa;
   cov_ab_ = line.cab;
   cov_bb_ = line.cbb;

@@ -114,6 +114,39 @@ Pose LidarModel::LidarPoseAt(double t) const {
   return T_W_l;
 }
 
+void LidarModel::CollectCandidates(double start_time_s) {
+  candidates_.clear();
+  if (objects_ == nullptr) return;
+  constexpr int kSamples = 16;
+  for (int j = 0; j < static_cast<int>(objects_->size()); ++j) {
+    if (j == own_object_) continue;
+    const MovingObject& obj = (*objects_)[j];
+    const Eigen::Vector3d center = obj.trajectory->PositionAt(start_time_s + 0.5 * period_);
+    double deviation = 0.0;
+    double step = 0.0;
+    Eigen::Vector3d previous = obj.trajectory->PositionAt(start_time_s);
+    for (int s = 0; s <= kSamples; ++s) {
+      const Eigen::Vector3d p = obj.trajectory->PositionAt(start_time_s + period_ * s / kSamples);
+      deviation = std::max(deviation, (p - center).norm());
+      step = std::max(step, (p - previous).norm());
+      previous = p;
+    }
+    candidates_.push_back({j, center, obj.bounding_radius_m + deviation + step + 0.05});
+  }
+}
+
+LidarModel::Footprint LidarModel::BeamFootprint() const {
+  const LidarImperfectionOptions& imp = options_.imperfections;
+  Footprint f;
+  f.angular_sigma = imp.angular_noise_deg * kDeg;
+  f.half_divergence_h = 0.5 * imp.beam_divergence_horizontal_deg * kDeg;
+  f.half_divergence_v = 0.5 * imp.beam_divergence_vertical_deg * kDeg;
+  f.divergence_rms = std::sqrt(2.0 * (f.half_divergence_h * f.half_divergence_h +
+                                      f.half_divergence_v * f.half_divergence_v));
+  f.needs_axes = f.angular_sigma > 0.0 || imp.SamplesFootprint();
+  return f;
+}
+
 void LidarModel::Scan(int64_t frame, SimulatedScan* scan) {
   scan->frame_index = frame;
   scan->start_time_s = FrameStart(frame);
@@ -124,138 +157,147 @@ void LidarModel::Scan(int64_t frame, SimulatedScan* scan) {
   scan->points.reserve(static_cast<size_t>(pulses_per_frame));
 
   // Bounding spheres of the other moving objects over this frame.
-  candidates_.clear();
-  if (objects_ != nullptr) {
-    constexpr int kSamples = 16;
-    for (int j = 0; j < static_cast<int>(objects_->size()); ++j) {
-      if (j == own_object_) continue;
-      const MovingObject& obj = (*objects_)[j];
-      const Eigen::Vector3d center = obj.trajectory->PositionAt(scan->start_time_s + 0.5 * period_);
-      double deviation = 0.0;
-      double step = 0.0;
-      Eigen::Vector3d previous = obj.trajectory->PositionAt(scan->start_time_s);
-      for (int s = 0; s <= kSamples; ++s) {
-        const Eigen::Vector3d p =
-            obj.trajectory->PositionAt(scan->start_time_s + period_ * s / kSamples);
-        deviation = std::max(deviation, (p - center).norm());
-        step = std::max(step, (p - previous).norm());
-        previous = p;
-      }
-      candidates_.push_back({j, center, obj.bounding_radius_m + deviation + step + 0.05});
-    }
-  }
+  CollectCandidates(scan->start_time_s);
 
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   std::normal_distribution<double> normal;
+  const Footprint footprint = BeamFootprint();
+  const int64_t first_pulse = frame * pulses_per_frame;
+  for (int64_t i = 0; i < pulses_per_frame; ++i) {
+    SimulatePulse(first_pulse + i, footprint, &uniform, &normal, &scan->points);
+  }
+}
+
+LidarModel::Pulse LidarModel::AimPulse(int64_t k, const Footprint& footprint) const {
+  Pulse pulse;
+  pulse.t = t0_ + static_cast<double>(k) / pattern_.pulse_rate_hz();
+  pattern_.Direction(k, &pulse.dir_l, &pulse.line);
+  pulse.T_W_l = LidarPoseAt(pulse.t);
+
+  // Imperfections: counter-based draws (a pure function of the pulse), so
+  // each effect sees the same numbers whatever else is enabled.
+  pulse.index = static_cast<uint64_t>(k);
+  pulse.beam_l = pulse.dir_l;  // where the pulse really goes
+  if (footprint.needs_axes) FootprintAxes(pulse.dir_l, &pulse.axis_h, &pulse.axis_v);
+  if (footprint.angular_sigma > 0.0) {
+    double n_h, n_v;
+    NormalPair(imperfection_key_, pulse.index, kAngularNoise, &n_h, &n_v);
+    pulse.beam_l =
+        (pulse.dir_l + footprint.angular_sigma * (n_h * pulse.axis_h + n_v * pulse.axis_v))
+            .normalized();
+  }
+  pulse.ray = Ray{pulse.T_W_l.p_b_in_W, pulse.T_W_l.R_W_b * pulse.beam_l};
+  return pulse;
+}
+
+void LidarModel::SimulatePulse(int64_t k,
+                               const Footprint& footprint,
+                               std::uniform_real_distribution<double>* uniform,
+                               std::normal_distribution<double>* normal,
+                               std::vector<SimulatedPoint>* points) {
   const LidarOptions& sensor = options_.sensor;
   const LidarImperfectionOptions& imp = options_.imperfections;
-  const double angular_sigma = imp.angular_noise_deg * kDeg;
-  const double half_divergence_h = 0.5 * imp.beam_divergence_horizontal_deg * kDeg;
-  const double half_divergence_v = 0.5 * imp.beam_divergence_vertical_deg * kDeg;
-  const double divergence_rms = std::sqrt(
-      2.0 * (half_divergence_h * half_divergence_h + half_divergence_v * half_divergence_v));
-  const bool needs_axes = angular_sigma > 0.0 || imp.SamplesFootprint();
-  const int64_t first_pulse = frame * pulses_per_frame;
-  const double max_range = sensor.max_range_m;
-  for (int64_t i = 0; i < pulses_per_frame; ++i) {
-    const int64_t k = first_pulse + i;
-    const double t = t0_ + static_cast<double>(k) / pattern_.pulse_rate_hz();
-    Eigen::Vector3d dir_l;
-    uint8_t line;
-    pattern_.Direction(k, &dir_l, &line);
-    const Pose T_W_l = LidarPoseAt(t);
-
-    // Imperfections: counter-based draws (a pure function of the pulse), so
-    // each effect sees the same numbers whatever else is enabled.
-    const uint64_t pulse = static_cast<uint64_t>(k);
-    Eigen::Vector3d beam_l = dir_l;  // where the pulse really goes
-    Eigen::Vector3d axis_h = Eigen::Vector3d::Zero(), axis_v = Eigen::Vector3d::Zero();
-    if (needs_axes) FootprintAxes(dir_l, &axis_h, &axis_v);
-    if (angular_sigma > 0.0) {
-      double n_h, n_v;
-      NormalPair(imperfection_key_, pulse, kAngularNoise, &n_h, &n_v);
-      beam_l = (dir_l + angular_sigma * (n_h * axis_h + n_v * axis_v)).normalized();
-    }
-    const Ray ray{T_W_l.p_b_in_W, T_W_l.R_W_b * beam_l};
-    const Hit main = Cast(ray, t);
-    // Draw the random numbers for every pulse so that the stream does not
-    // depend on the geometry hit.
-    const double dropout_draw = uniform(rng_);
-    const double range_draw = normal(rng_);
-    if (!main.hit.hit() || main.hit.t < sensor.blind_range_m) continue;
-    if (dropout_draw < options_.dropout_probability) continue;
-    if (imp.range_dropout_at_max_range > 0.0) {
-      const double loss =
-          imp.range_dropout_at_max_range *
-          std::pow(std::min(1.0, main.hit.t / max_range), imp.range_dropout_exponent);
-      if (CounterUniform(imperfection_key_, pulse, kRangeDropout) <= loss) continue;
-    }
-    SimulatedPoint p;
-    p.t_s = t;
-    p.true_range_m = main.hit.t;
-    p.true_p_in_lidar = beam_l * main.hit.t;
-    p.cos_incidence = std::abs(main.hit.normal.dot(ray.direction));
-    p.reflectivity =
-        Reflectivity(options_.reflectivity, *main.material, main.hit.t, p.cos_incidence, &rng_);
-    p.line = line;
-    p.object = main.object;
-    p.primitive = main.hit.primitive;
-
-    // Depth edges: a second sample of the footprint.
-    double signal_range = main.hit.t;
-    bool two_returns = false;
-    Hit other;
-    Eigen::Vector3d probe_l = beam_l;
-    if (imp.multi_return ||
-        (imp.mixed_pixel_probability > 0.0 &&
-         CounterUniform(imperfection_key_, pulse, kMixDecision) <= imp.mixed_pixel_probability)) {
-      // Uniform over the elliptic footprint.
-      const double radius = std::sqrt(CounterUniform(imperfection_key_, pulse, kProbeRadius));
-      const double angle = 2.0 * M_PI * CounterUniform(imperfection_key_, pulse, kProbeAngle);
-      probe_l = (beam_l + radius * (std::cos(angle) * half_divergence_h * axis_h +
-                                    std::sin(angle) * half_divergence_v * axis_v))
-                    .normalized();
-      other = Cast(Ray{ray.origin, T_W_l.R_W_b * probe_l}, t);
-      const bool other_surface =
-          other.object != main.object || other.hit.primitive != main.hit.primitive;
-      if (other.hit.hit() && other.hit.t >= sensor.blind_range_m && other_surface &&
-          std::abs(other.hit.t - main.hit.t) > imp.edge_min_separation_m) {
-        if (imp.multi_return) {
-          two_returns = true;
-        } else {
-          const double weight = 1.0 - CounterUniform(imperfection_key_, pulse, kMixWeight);
-          signal_range = main.hit.t + weight * (other.hit.t - main.hit.t);
-          p.mixed = true;
-          p.mixed_other_range_m = other.hit.t;
-        }
-      }
-    }
-    p.p_in_lidar = dir_l * MeasuredRange(sensor, imp, divergence_rms, signal_range, p.cos_incidence,
-                                         p.reflectivity, range_draw);
-    if (!two_returns) {
-      scan->points.push_back(p);
-      continue;
-    }
-    // Dual return: both surfaces, reported along the same nominal direction,
-    // the nearer one first.
-    SimulatedPoint q = p;
-    q.true_range_m = other.hit.t;
-    q.true_p_in_lidar = probe_l * other.hit.t;
-    q.cos_incidence = std::abs(other.hit.normal.dot(T_W_l.R_W_b * probe_l));
-    q.reflectivity = Reflectivity(options_.reflectivity, *other.material, other.hit.t,
-                                  q.cos_incidence, &second_return_rng_);
-    q.object = other.object;
-    q.primitive = other.hit.primitive;
-    double second_noise, unused;
-    NormalPair(imperfection_key_, pulse, kSecondReturnNoise, &second_noise, &unused);
-    q.p_in_lidar = dir_l * MeasuredRange(sensor, imp, divergence_rms, other.hit.t, q.cos_incidence,
-                                         q.reflectivity, second_noise);
-    const bool main_first = main.hit.t <= other.hit.t;
-    p.tag = main_first ? kFirstReturn : kSecondReturn;
-    q.tag = main_first ? kSecondReturn : kFirstReturn;
-    scan->points.push_back(main_first ? p : q);
-    scan->points.push_back(main_first ? q : p);
+  const Pulse pulse = AimPulse(k, footprint);
+  const Hit main = Cast(pulse.ray, pulse.t);
+  // Draw the random numbers for every pulse so that the stream does not
+  // depend on the geometry hit.
+  const double dropout_draw = (*uniform)(rng_);
+  const double range_draw = (*normal)(rng_);
+  if (!main.hit.hit() || main.hit.t < sensor.blind_range_m) return;
+  if (dropout_draw < options_.dropout_probability) return;
+  if (imp.range_dropout_at_max_range > 0.0) {
+    const double loss =
+        imp.range_dropout_at_max_range *
+        std::pow(std::min(1.0, main.hit.t / sensor.max_range_m), imp.range_dropout_exponent);
+    if (CounterUniform(imperfection_key_, pulse.index, kRangeDropout) <= loss) return;
   }
+  SimulatedPoint p;
+  p.t_s = pulse.t;
+  p.true_range_m = main.hit.t;
+  p.true_p_in_lidar = pulse.beam_l * main.hit.t;
+  p.cos_incidence = std::abs(main.hit.normal.dot(pulse.ray.direction));
+  p.reflectivity =
+      Reflectivity(options_.reflectivity, *main.material, main.hit.t, p.cos_incidence, &rng_);
+  p.line = pulse.line;
+  p.object = main.object;
+  p.primitive = main.hit.primitive;
+
+  // Depth edges: a second sample of the footprint.
+  double signal_range = main.hit.t;
+  bool two_returns = false;
+  Hit other;
+  Eigen::Vector3d probe_l = pulse.beam_l;
+  if (ProbeEdge(pulse, footprint, main, &other, &probe_l)) {
+    if (imp.multi_return) {
+      two_returns = true;
+    } else {
+      const double weight = 1.0 - CounterUniform(imperfection_key_, pulse.index, kMixWeight);
+      signal_range = main.hit.t + weight * (other.hit.t - main.hit.t);
+      p.mixed = true;
+      p.mixed_other_range_m = other.hit.t;
+    }
+  }
+  p.p_in_lidar = pulse.dir_l * MeasuredRange(sensor, imp, footprint.divergence_rms, signal_range,
+                                             p.cos_incidence, p.reflectivity, range_draw);
+  if (!two_returns) {
+    points->push_back(p);
+    return;
+  }
+  AppendDualReturn(pulse, footprint, main, other, probe_l, p, points);
+}
+
+bool LidarModel::ProbeEdge(const Pulse& pulse,
+                           const Footprint& footprint,
+                           const Hit& main,
+                           Hit* other,
+                           Eigen::Vector3d* probe_l) const {
+  const LidarImperfectionOptions& imp = options_.imperfections;
+  const bool sampled =
+      imp.multi_return ||
+      (imp.mixed_pixel_probability > 0.0 &&
+       CounterUniform(imperfection_key_, pulse.index, kMixDecision) <= imp.mixed_pixel_probability);
+  if (!sampled) return false;
+  // Uniform over the elliptic footprint.
+  const double radius = std::sqrt(CounterUniform(imperfection_key_, pulse.index, kProbeRadius));
+  const double angle = 2.0 * M_PI * CounterUniform(imperfection_key_, pulse.index, kProbeAngle);
+  *probe_l =
+      (pulse.beam_l + radius * (std::cos(angle) * footprint.half_divergence_h * pulse.axis_h +
+                                std::sin(angle) * footprint.half_divergence_v * pulse.axis_v))
+          .normalized();
+  *other = Cast(Ray{pulse.ray.origin, pulse.T_W_l.R_W_b * *probe_l}, pulse.t);
+  const bool other_surface =
+      other->object != main.object || other->hit.primitive != main.hit.primitive;
+  return other->hit.hit() && other->hit.t >= options_.sensor.blind_range_m && other_surface &&
+         std::abs(other->hit.t - main.hit.t) > imp.edge_min_separation_m;
+}
+
+void LidarModel::AppendDualReturn(const Pulse& pulse,
+                                  const Footprint& footprint,
+                                  const Hit& main,
+                                  const Hit& other,
+                                  const Eigen::Vector3d& probe_l,
+                                  SimulatedPoint p,
+                                  std::vector<SimulatedPoint>* points) {
+  // Dual return: both surfaces, reported along the same nominal direction,
+  // the nearer one first.
+  SimulatedPoint q = p;
+  q.true_range_m = other.hit.t;
+  q.true_p_in_lidar = probe_l * other.hit.t;
+  q.cos_incidence = std::abs(other.hit.normal.dot(pulse.T_W_l.R_W_b * probe_l));
+  q.reflectivity = Reflectivity(options_.reflectivity, *other.material, other.hit.t,
+                                q.cos_incidence, &second_return_rng_);
+  q.object = other.object;
+  q.primitive = other.hit.primitive;
+  double second_noise, unused;
+  NormalPair(imperfection_key_, pulse.index, kSecondReturnNoise, &second_noise, &unused);
+  q.p_in_lidar =
+      pulse.dir_l * MeasuredRange(options_.sensor, options_.imperfections, footprint.divergence_rms,
+                                  other.hit.t, q.cos_incidence, q.reflectivity, second_noise);
+  const bool main_first = main.hit.t <= other.hit.t;
+  p.tag = main_first ? kFirstReturn : kSecondReturn;
+  q.tag = main_first ? kSecondReturn : kFirstReturn;
+  points->push_back(main_first ? p : q);
+  points->push_back(main_first ? q : p);
 }
 
 LidarModel::Hit LidarModel::Cast(const Ray& ray, double t) const {

@@ -125,6 +125,130 @@ Status RegisterBlocks(const std::vector<double*>& list,
   return Status::Ok();
 }
 
+// Each residual's blocks (slots in `blocks`), with consistent sizes and
+// manifolds; fills in each block's size and manifold from its first residual.
+Status ResolveResidualBlocks(const std::vector<MarginalizationResidualBlock>& residual_blocks,
+                             const std::unordered_map<const double*, int>& index,
+                             std::vector<Block>* blocks,
+                             std::vector<std::vector<int>>* residual_slots) {
+  residual_slots->assign(residual_blocks.size(), {});
+  for (size_t r = 0; r < residual_blocks.size(); ++r) {
+    const MarginalizationResidualBlock& rb = residual_blocks[r];
+    const std::vector<int32_t>& sizes = rb.cost_function->parameter_block_sizes();
+    bool touches_marginalized = false;
+    for (size_t i = 0; i < rb.parameter_blocks.size(); ++i) {
+      const auto it = index.find(rb.parameter_blocks[i]);
+      if (it == index.end()) {
+        return Status::InvalidArgument(ResidualName(r) + ": parameter block " + std::to_string(i) +
+                                       " is neither kept nor marginalized");
+      }
+      Block& block = (*blocks)[it->second];
+      if (!block.touched) {
+        block.touched = true;
+        block.ambient = sizes[i];
+        block.manifold = rb.manifolds[i];
+        block.tangent = block.manifold == nullptr ? sizes[i] : block.manifold->TangentSize();
+      } else if (block.ambient != sizes[i] || block.manifold != rb.manifolds[i]) {
+        return Status::InvalidArgument(ResidualName(r) + ": parameter block " + std::to_string(i) +
+                                       " has another size or manifold than in an earlier residual");
+      }
+      touches_marginalized = touches_marginalized || !block.kept;
+      (*residual_slots)[r].push_back(it->second);
+    }
+    if (!touches_marginalized) {
+      return Status::InvalidArgument(ResidualName(r) +
+                                     " touches no marginalized block (it belongs in the window)");
+    }
+  }
+  return Status::Ok();
+}
+
+// Each block's offset in the tangent system; *dim: its size, *kept_dim: the
+// size of its kept part (the leading blocks).
+Status AssignOffsets(std::vector<Block>* blocks, int* dim, int* kept_dim) {
+  *dim = 0;
+  *kept_dim = 0;
+  for (Block& block : *blocks) {
+    if (!block.touched) {
+      return Status::InvalidArgument(std::string("a ") + (block.kept ? "kept" : "marginalized") +
+                                     " block is in no residual block");
+    }
+    block.offset = *dim;
+    *dim += block.tangent;
+    if (block.kept) *kept_dim = *dim;
+  }
+  return Status::Ok();
+}
+
+// H = sum J^T J, b = sum J^T r in the tangent space, each residual evaluated once.
+Status NormalEquations(const std::vector<MarginalizationResidualBlock>& residual_blocks,
+                       const std::vector<Block>& blocks,
+                       const std::vector<std::vector<int>>& residual_slots,
+                       int dim,
+                       Eigen::MatrixXd* H_out,
+                       Eigen::VectorXd* b_out) {
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(dim);
+  Eigen::VectorXd residual;
+  std::vector<Eigen::MatrixXd> J;
+  for (size_t r = 0; r < residual_blocks.size(); ++r) {
+    std::vector<const Block*> rb_blocks;
+    for (int slot : residual_slots[r]) rb_blocks.push_back(&blocks[slot]);
+    SWARMLIO_RETURN_IF_ERROR(
+        Linearize(residual_blocks[r], rb_blocks, &residual, &J).WithContext(ResidualName(r)));
+    for (size_t i = 0; i < rb_blocks.size(); ++i) {
+      const Block& bi = *rb_blocks[i];
+      b.segment(bi.offset, bi.tangent).noalias() += J[i].transpose() * residual;
+      for (size_t j = 0; j < rb_blocks.size(); ++j) {
+        const Block& bj = *rb_blocks[j];
+        H.block(bi.offset, bj.offset, bi.tangent, bj.tangent).noalias() += J[i].transpose() * J[j];
+      }
+    }
+  }
+  *H_out = std::move(H);
+  *b_out = std::move(b);
+  return Status::Ok();
+}
+
+// Schur complement with H_mm^+ = V_s diag(1/l_s) V_s^T (l_s: the eigenvalues above
+// the threshold): W = H_km V_s diag(1/sqrt(l_s)), H* = H_kk - W W^T (symmetric by
+// construction), b* = b_k - W diag(1/sqrt(l_s)) V_s^T b_m. Fills the prior's
+// information, gradient, marginalized_dim and marginalized_rank.
+Status SchurComplement(const Eigen::MatrixXd& H,
+                       const Eigen::VectorXd& b,
+                       int kept_dim,
+                       int marginalized_dim,
+                       double min_relative_eigenvalue,
+                       MarginalizationPrior* out) {
+  const Eigen::MatrixXd H_mm =
+      0.5 * (H.bottomRightCorner(marginalized_dim, marginalized_dim) +
+             H.bottomRightCorner(marginalized_dim, marginalized_dim).transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H_mm);
+  if (eig.info() != Eigen::Success) {
+    return Status::FailedPrecondition("eigen-decomposition of H_mm failed");
+  }
+  const Eigen::VectorXd& l = eig.eigenvalues();
+  const double threshold = min_relative_eigenvalue * std::max(l.maxCoeff(), 0.0);
+  std::vector<int> used;
+  for (int k = 0; k < marginalized_dim; ++k) {
+    if (l[k] > threshold && l[k] > 0.0) used.push_back(k);
+  }
+  const int rank = static_cast<int>(used.size());
+  Eigen::MatrixXd U(marginalized_dim, rank);  // V_s diag(1/sqrt(l_s))
+  for (int c = 0; c < rank; ++c) {
+    U.col(c) = eig.eigenvectors().col(used[c]) / std::sqrt(l[used[c]]);
+  }
+  const Eigen::MatrixXd W = H.topRightCorner(kept_dim, marginalized_dim) * U;
+  const Eigen::VectorXd u = U.transpose() * b.tail(marginalized_dim);
+
+  out->information = H.topLeftCorner(kept_dim, kept_dim) - W * W.transpose();
+  out->information = 0.5 * (out->information + out->information.transpose());
+  out->gradient = b.head(kept_dim) - W * u;
+  out->marginalized_dim = marginalized_dim;
+  out->marginalized_rank = rank;
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status Marginalizer::Create(const MarginalizationOptions& options,
@@ -178,96 +302,20 @@ Status Marginalizer::Marginalize(const std::vector<double*>& marginalized,
   SWARMLIO_RETURN_IF_ERROR(RegisterBlocks(marginalized, false, "marginalized", &blocks, &index));
 
   // Each residual's blocks, with consistent sizes and manifolds.
-  std::vector<std::vector<int>> residual_slots(residual_blocks_.size());
-  for (size_t r = 0; r < residual_blocks_.size(); ++r) {
-    const MarginalizationResidualBlock& rb = residual_blocks_[r];
-    const std::vector<int32_t>& sizes = rb.cost_function->parameter_block_sizes();
-    bool touches_marginalized = false;
-    for (size_t i = 0; i < rb.parameter_blocks.size(); ++i) {
-      const auto it = index.find(rb.parameter_blocks[i]);
-      if (it == index.end()) {
-        return Status::InvalidArgument(ResidualName(r) + ": parameter block " + std::to_string(i) +
-                                       " is neither kept nor marginalized");
-      }
-      Block& block = blocks[it->second];
-      if (!block.touched) {
-        block.touched = true;
-        block.ambient = sizes[i];
-        block.manifold = rb.manifolds[i];
-        block.tangent = block.manifold == nullptr ? sizes[i] : block.manifold->TangentSize();
-      } else if (block.ambient != sizes[i] || block.manifold != rb.manifolds[i]) {
-        return Status::InvalidArgument(ResidualName(r) + ": parameter block " + std::to_string(i) +
-                                       " has another size or manifold than in an earlier residual");
-      }
-      touches_marginalized = touches_marginalized || !block.kept;
-      residual_slots[r].push_back(it->second);
-    }
-    if (!touches_marginalized) {
-      return Status::InvalidArgument(ResidualName(r) +
-                                     " touches no marginalized block (it belongs in the window)");
-    }
-  }
+  std::vector<std::vector<int>> residual_slots;
+  SWARMLIO_RETURN_IF_ERROR(
+      ResolveResidualBlocks(residual_blocks_, index, &blocks, &residual_slots));
   int dim = 0;
   int kept_dim = 0;
-  for (Block& block : blocks) {
-    if (!block.touched) {
-      return Status::InvalidArgument(std::string("a ") + (block.kept ? "kept" : "marginalized") +
-                                     " block is in no residual block");
-    }
-    block.offset = dim;
-    dim += block.tangent;
-    if (block.kept) kept_dim = dim;
-  }
+  SWARMLIO_RETURN_IF_ERROR(AssignOffsets(&blocks, &dim, &kept_dim));
   const int marginalized_dim = dim - kept_dim;
 
-  // H = sum J^T J, b = sum J^T r in the tangent space, each residual evaluated once.
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(dim);
-  Eigen::VectorXd residual;
-  std::vector<Eigen::MatrixXd> J;
-  for (size_t r = 0; r < residual_blocks_.size(); ++r) {
-    std::vector<const Block*> rb_blocks;
-    for (int slot : residual_slots[r]) rb_blocks.push_back(&blocks[slot]);
-    SWARMLIO_RETURN_IF_ERROR(
-        Linearize(residual_blocks_[r], rb_blocks, &residual, &J).WithContext(ResidualName(r)));
-    for (size_t i = 0; i < rb_blocks.size(); ++i) {
-      const Block& bi = *rb_blocks[i];
-      b.segment(bi.offset, bi.tangent).noalias() += J[i].transpose() * residual;
-      for (size_t j = 0; j < rb_blocks.size(); ++j) {
-        const Block& bj = *rb_blocks[j];
-        H.block(bi.offset, bj.offset, bi.tangent, bj.tangent).noalias() += J[i].transpose() * J[j];
-      }
-    }
-  }
-
-  // Schur complement with H_mm^+ = V_s diag(1/l_s) V_s^T (l_s: the eigenvalues above
-  // the threshold): W = H_km V_s diag(1/sqrt(l_s)), H* = H_kk - W W^T (symmetric by
-  // construction), b* = b_k - W diag(1/sqrt(l_s)) V_s^T b_m.
-  const Eigen::MatrixXd H_mm =
-      0.5 * (H.bottomRightCorner(marginalized_dim, marginalized_dim) +
-             H.bottomRightCorner(marginalized_dim, marginalized_dim).transpose());
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H_mm);
-  if (eig.info() != Eigen::Success) {
-    return Status::FailedPrecondition("eigen-decomposition of H_mm failed");
-  }
-  const Eigen::VectorXd& l = eig.eigenvalues();
-  const double threshold = options_.min_relative_eigenvalue * std::max(l.maxCoeff(), 0.0);
-  std::vector<int> used;
-  for (int k = 0; k < marginalized_dim; ++k) {
-    if (l[k] > threshold && l[k] > 0.0) used.push_back(k);
-  }
-  const int rank = static_cast<int>(used.size());
-  Eigen::MatrixXd U(marginalized_dim, rank);  // V_s diag(1/sqrt(l_s))
-  for (int c = 0; c < rank; ++c) {
-    U.col(c) = eig.eigenvectors().col(used[c]) / std::sqrt(l[used[c]]);
-  }
-  const Eigen::MatrixXd W = H.topRightCorner(kept_dim, marginalized_dim) * U;
-  const Eigen::VectorXd u = U.transpose() * b.tail(marginalized_dim);
-
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  SWARMLIO_RETURN_IF_ERROR(NormalEquations(residual_blocks_, blocks, residual_slots, dim, &H, &b));
   MarginalizationPrior out;
-  out.information = H.topLeftCorner(kept_dim, kept_dim) - W * W.transpose();
-  out.information = 0.5 * (out.information + out.information.transpose());
-  out.gradient = b.head(kept_dim) - W * u;
+  SWARMLIO_RETURN_IF_ERROR(
+      SchurComplement(H, b, kept_dim, marginalized_dim, options_.min_relative_eigenvalue, &out));
   for (const Block& block : blocks) {
     if (!block.kept) continue;
     out.parameter_blocks.push_back(block.values);
@@ -277,8 +325,6 @@ Status Marginalizer::Marginalize(const std::vector<double*>& marginalized,
     out.ambient_sizes.push_back(block.ambient);
     out.tangent_sizes.push_back(block.tangent);
   }
-  out.marginalized_dim = marginalized_dim;
-  out.marginalized_rank = rank;
   *prior = std::move(out);
   return Status::Ok();
 }

@@ -214,6 +214,12 @@ class ClockOffsetEstimator {
   uint64_t resets() const { return resets_; }
 
  private:
+  // Drops samples beyond the window (count, age); false when none is left,
+  // else sets the base time and offset (newest sample) and min_delay_ns_.
+  bool TrimWindow();
+  // The window's samples the fit uses: all, or (kRobustFitMinSamples and
+  // more) those the outlier model does not reject.
+  std::vector<TimeSyncSample> SamplesToFit(double prior_info) const;
   void Fit();
   double OffsetAt(int64_t local_ns) const;  // relative to base_offset_ns_ [ns]
   double VarianceAt(int64_t local_ns) const;

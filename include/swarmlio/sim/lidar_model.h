@@ -80,6 +80,54 @@ class LidarModel {
   };
   Hit Cast(const Ray& ray, double t) const;
 
+  // The beam shape of the imperfections, the same for every pulse [rad].
+  struct Footprint {
+    double angular_sigma = 0.0;      // pointing noise
+    double half_divergence_h = 0.0;  // half-angles of the elliptic footprint
+    double half_divergence_v = 0.0;
+    double divergence_rms = 0.0;  // of the footprint (incidence noise)
+    bool needs_axes = false;      // angular noise or footprint sampling
+  };
+  // One pulse: its time, nominal direction and the beam it really fires.
+  struct Pulse {
+    uint64_t index = 0;     // the pulse counter (imperfection draws)
+    double t = 0.0;         // true time [s]
+    Eigen::Vector3d dir_l;  // nominal direction (LiDAR frame), the reported one
+    uint8_t line = 0;
+    Pose T_W_l;                                        // LiDAR pose at t
+    Eigen::Vector3d beam_l;                            // where the pulse really goes (LiDAR frame)
+    Eigen::Vector3d axis_h = Eigen::Vector3d::Zero();  // footprint axes (FootprintAxes)
+    Eigen::Vector3d axis_v = Eigen::Vector3d::Zero();
+    Ray ray;  // the beam in W
+  };
+  Footprint BeamFootprint() const;
+  // Bounding spheres of the other moving objects over the frame starting at
+  // `start_time_s` (candidates_).
+  void CollectCandidates(double start_time_s);
+  Pulse AimPulse(int64_t k, const Footprint& footprint) const;
+  // Simulates pulse k: appends its return(s) to *points, if any.
+  void SimulatePulse(int64_t k,
+                     const Footprint& footprint,
+                     std::uniform_real_distribution<double>* uniform,
+                     std::normal_distribution<double>* normal,
+                     std::vector<SimulatedPoint>* points);
+  // Depth edges: true when a second sample of the footprint (*probe_l) hits
+  // another surface (*other) at a depth step from `main`.
+  bool ProbeEdge(const Pulse& pulse,
+                 const Footprint& footprint,
+                 const Hit& main,
+                 Hit* other,
+                 Eigen::Vector3d* probe_l) const;
+  // Dual return: `p` (of `main`) and the return of `other` at probe_l, the
+  // nearer one first.
+  void AppendDualReturn(const Pulse& pulse,
+                        const Footprint& footprint,
+                        const Hit& main,
+                        const Hit& other,
+                        const Eigen::Vector3d& probe_l,
+                        SimulatedPoint p,
+                        std::vector<SimulatedPoint>* points);
+
   SimulatedLidarOptions options_;
   LidarPattern pattern_;
   const Trajectory* own_trajectory_;
