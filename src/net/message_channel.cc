@@ -67,9 +67,12 @@ void MessageChannel::StampSendTime(int64_t now_ns, EgoStateMessage* m) {
   }
   m->send_delay_ns = delay_ns;
   if (delay_ns < 0) {
+    // Echoes and the offset report are measured against the send delay:
+    // without it they go, the state itself still leaves.
     ++stats_.send_delay_unknown;
     stats_.echoes_dropped += m->echoes.size();
     m->echoes.clear();
+    m->offset_report.reset();
     return;
   }
   const size_t before = m->echoes.size();

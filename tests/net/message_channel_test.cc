@@ -7,6 +7,8 @@
 #include <limits>
 #include <set>
 #include <utility>
+#include <variant>
+#include <vector>
 
 #include "swarmlio/net/simulated_network.h"
 #include "tests/net/net_test_util.h"
@@ -122,6 +124,34 @@ TEST(MessageChannel, DropsItsOwnEchoedPackets) {
   ASSERT_TRUE(channel.Poll(0, &inbox).ok());
   EXPECT_TRUE(inbox.empty());
   EXPECT_EQ(channel.stats().own_packets, 1u);
+}
+
+// A state sent too late for its send delay to be encoded (a loaded machine)
+// still leaves; its echoes and offset report, which need the delay, do not.
+// The report used to stay and the encoder refused the whole message.
+TEST(MessageChannel, AStateSentTooLateForItsDelayStillLeavesWithoutItsClockItems) {
+  const PacketCodec codec = MakeCodec();
+  EchoTransport echo;
+  MessageChannel channel(&codec, &echo);
+  EgoStateMessage m = MakeEgoState(/*sender=*/4, 1, 154, 0, /*num_echoes=*/1);
+  m.offset_report = ClockOffsetReport{63, 0xFFFE, 1};
+  const int64_t now_ns = m.stamp_ns + int64_t{3600} * 1000 * kMs;  // an hour late
+  ASSERT_TRUE(channel.Send(now_ns, kBroadcastId, m).ok());
+  EXPECT_EQ(channel.stats().sent, 1u);
+  EXPECT_EQ(channel.stats().send_delay_unknown, 1u);
+  EXPECT_EQ(channel.stats().echoes_dropped, 1u);
+  // The state itself is intact.
+  std::vector<Datagram> sent;
+  ASSERT_TRUE(echo.Poll(now_ns, &sent).ok());
+  ASSERT_EQ(sent.size(), 1u);
+  DecodedPacket decoded;
+  ASSERT_TRUE(codec.Decode(sent[0].bytes.data(), sent[0].bytes.size(), &decoded).ok());
+  const auto* state = std::get_if<EgoStateMessage>(&decoded.message);
+  ASSERT_NE(state, nullptr);
+  EXPECT_FALSE(state->offset_report.has_value());
+  EXPECT_TRUE(state->echoes.empty());
+  EXPECT_EQ(state->stamp_ns, m.stamp_ns);
+  EXPECT_EQ(state->p_bj_in_Gj, m.p_bj_in_Gj);
 }
 
 }  // namespace
