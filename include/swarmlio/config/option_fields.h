@@ -45,7 +45,9 @@
 // handles it. A struct visits at most one group of a given name (inline
 // extensions included). The loader reports a grouped key found at the
 // struct's own level as moved ("swarm.gate_sigma: moved to
-// swarm.experimental.gate_sigma").
+// swarm.experimental.gate_sigma"). Validate() messages name a grouped field
+// by its C++ path ("clock_sync.window_s", as code sets it); ConfigFile::Read
+// gives it its YAML path ("clock_sync.experimental.window_s").
 //
 // Loading from YAML: config/config_file.h. Rendering as documented YAML:
 // config/dump_options.h.
@@ -172,7 +174,7 @@ std::string ValidateFields(const Options& options);
 
 /// A named group of fields of the enclosing struct, visited as a nested YAML
 /// map (see the top of this file). `Body` is a callable taking the visitor:
-/// `[&](auto& v) { v("key", member, spec); ... }`. Only a view: it refers to
+/// `[&](auto& x) { x("key", member, spec); ... }`. Only a view: it refers to
 /// the enclosing struct's members and lives for one VisitFields() call.
 template <class Body>
 class FieldGroup {
@@ -184,6 +186,7 @@ class FieldGroup {
     body_(v);
   }
   /// Range checks of the grouped fields ("key: reason", key relative to the group).
+  /// (ValidateFields of the enclosing struct checks them without the group's name.)
   std::string Validate() const { return ValidateFields(*this); }
 
  private:
@@ -282,6 +285,9 @@ class RangeChecker {
       for (size_t i = 0; i < field.size() && error_.empty(); ++i) {
         error_ = CheckScalar(IndexKey(full, i), field[i], spec);
       }
+    } else if constexpr (IsFieldGroup<T>::value) {
+      (void)spec;
+      field.VisitFields(*this);  // no level of its own: keys keep their C++ path
     } else if constexpr (IsOptionsStruct<T>::value) {
       (void)spec;
       error_ = PrefixError(full, field.Validate());
