@@ -172,7 +172,8 @@ ReadError ExpectList(const YamlNode& node, const std::string& key) {
 
 ReadError CheckKeys(const YamlNode& node,
                     const std::string& prefix,
-                    const std::vector<std::string>& known) {
+                    const std::vector<std::string>& known,
+                    const std::vector<GroupedKey>& grouped) {
   std::map<std::string, int> first_line;
   for (const YamlNode::Entry& entry : node.Entries()) {
     ReadError error;
@@ -189,6 +190,12 @@ ReadError CheckKeys(const YamlNode& node,
       return error;
     }
     if (std::find(known.begin(), known.end(), entry.key) == known.end()) {
+      for (const auto& [key, group] : grouped) {
+        if (key != entry.key) continue;
+        error.reason = "moved to " + JoinKey(JoinKey(prefix, group), key) + " (research and " +
+                       "tuning keys live under '" + group + ":'; docs/configuration.md)";
+        return error;
+      }
       error.reason = UnknownNameReason("key", entry.key, known);
       return error;
     }

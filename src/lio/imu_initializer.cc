@@ -125,12 +125,14 @@ void ResolveSign(const ImuInitializerOptions& options,
   } else if (direction == SpecificForceDirection::kDown && *sign == 1) {
     *sign_warning = seen + ", gravity comes out opposite to the configured sign: the driver "
                            "reports -(specific force) (or the IMU is mounted with up_axis "
-                           "down); set imu_init.acceleration_sign: -1 (or 0 = auto; replay "
-                           "manifest: odometry: {imu_init: {acceleration_sign: 0}}), or "
-                           "imu_init.up_axis to the IMU's up axis";
+                           "down); set odometry.experimental.imu_init.acceleration_sign: -1 "
+                           "(or 0 = auto; replay manifest: odometry: {experimental: "
+                           "{imu_init: {acceleration_sign: 0}}}), or imu_init.up_axis to the "
+                           "IMU's up axis";
   } else if (direction == SpecificForceDirection::kUp && *sign == -1) {
     *sign_warning = seen + ", gravity comes out opposite to the configured sign -1: the driver "
-                           "reports the specific force; set imu_init.acceleration_sign: 1 (or "
+                           "reports the specific force; set "
+                           "odometry.experimental.imu_init.acceleration_sign: 1 (or "
                            "0 = auto), or imu_init.up_axis to the IMU's up axis";
   }
 }

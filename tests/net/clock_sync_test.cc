@@ -70,9 +70,9 @@ TEST(ClockSyncOptions, ValidateNamesTheKey) {
 
 TEST(ClockSyncOptions, LoadFromYaml) {
   config::ConfigFile file;
-  ASSERT_TRUE(config::ConfigFile::Parse("clock_sync:\n  request_period_s: 0.5\n"
-                                        "  window_samples: 64\n"
-                                        "broken:\n  min_samples: 100\n  window_samples: 10\n",
+  ASSERT_TRUE(config::ConfigFile::Parse("clock_sync:\n  experimental:\n    request_period_s: 0.5\n"
+                                        "    window_samples: 64\n"
+                                        "broken:\n  experimental: {min_samples: 100, window_samples: 10}\n",
                                         "net.yaml", &file)
                   .ok());
   ClockSyncOptions o;

@@ -27,7 +27,7 @@ TEST(NetworkOptions, ReadsSectionWithOverrides) {
       "    bandwidth_bytes_per_s: 250000\n"
       "  links:\n"
       "    - {from_id: 0, to_id: 2, link: {loss_probability: 0.5}}\n"
-      "    - {to_id: 2, link: {duplicate_probability: 0.1}}\n";
+      "    - {to_id: 2, link: {experimental: {duplicate_probability: 0.1}}}\n";
   NetworkOptions o;
   const Status s = ReadNetwork(yaml, &o);
   ASSERT_TRUE(s.ok()) << s.message();
@@ -54,8 +54,10 @@ TEST(NetworkOptions, ErrorsNameTheKey) {
   EXPECT_NE(s.message().find("links[0].to_id"), std::string::npos) << s.message();
   s = ReadNetwork("network:\n  links:\n    - {from_id: 64}\n", &o);
   EXPECT_NE(s.message().find("links[0].from_id"), std::string::npos) << s.message();
-  s = ReadNetwork("network:\n  default_link:\n    max_queue_delay_s: 0\n", &o);
-  EXPECT_NE(s.message().find("max_queue_delay_s"), std::string::npos) << s.message();
+  s = ReadNetwork("network:\n  default_link:\n    experimental: {max_queue_delay_s: 0}\n", &o);
+  EXPECT_NE(s.message().find("network.default_link.experimental.max_queue_delay_s"),
+            std::string::npos)
+      << s.message();
   s = ReadNetwork("network:\n  latency: 3\n", &o);
   EXPECT_FALSE(s.ok());
   EXPECT_EQ(o.seed, NetworkOptions().seed);  // unchanged on error

@@ -19,13 +19,13 @@ TEST(Manifest, ReadsDronesPresetsAndOverrides) {
       "    sensor_preset: " + kPresets + "livox_avia.yaml\n"
       "    lidar: {blind_range_m: 1.5}\n"
       "    imu: {acceleration_unit: g}\n"
-      "    odometry: {imu_time_offset_s: 0.002, association: {num_neighbors: 6}}\n"
+      "    odometry: {imu_time_offset_s: 0.002, experimental: {association: {num_neighbors: 6}}}\n"
       "  - name: b\n"
       "    bag: /abs/b.bag\n"
       "    sensor_preset: " + kPresets + "livox_mid360.yaml\n"
       "    bag_topics: {imu_topic: /mavros/imu/data}\n"
       "    start_offset_s: 20\n"
-      "    odometry: {initialization: in_flight, in_flight: {passes: 2}}\n";
+      "    odometry: {initialization: in_flight, experimental: {in_flight: {passes: 2}}}\n";
   SwarmManifest m;
   const Status status = ParseManifest(yaml, "/data/run/swarm.yaml", &m);
   ASSERT_TRUE(status.ok()) << status.message();
@@ -62,12 +62,17 @@ TEST(Manifest, RejectsBadEntriesWithFileLineAndKey) {
       {"drones:\n  - {name: a}\n", "bag"},
       {"drones:\n  - {name: a, bag: x.bag}\n  - {name: a, bag: y.bag}\n", "duplicate"},
       {"drones:\n  - {name: a, bag: x.bag, odometry: {min_scan_pointz: 3}}\n", "min_scan_pointz"},
-      {"drones:\n  - {name: a, bag: x.bag, odometry: {min_scan_points: -3}}\n", "min_scan_points"},
+      {"drones:\n  - {name: a, bag: x.bag, odometry: {experimental: {min_scan_points: -3}}}\n",
+       "drones[0].odometry.experimental.min_scan_points: value -3 is out of range"},
+      {"drones:\n  - {name: a, bag: x.bag, odometry: {min_scan_points: 3}}\n",
+       "drones[0].odometry.min_scan_points: moved to "
+       "drones[0].odometry.experimental.min_scan_points"},
       {"drones:\n  - {name: a, bag: x.bag, sensor_preset: /no/such.yaml}\n", "sensor_preset"},
       {"drones:\n  - {name: a, bag: x.bag, start_offset_s: -1}\n", "start_offset_s"},
       {"drones:\n  - {name: a, bag: x.bag, odometry: {initialization: flying}}\n",
        "initialization"},
-      {"drones:\n  - {name: a, bag: x.bag, odometry: {in_flight: {passes: 0}}}\n", "passes"},
+      {"drones:\n  - {name: a, bag: x.bag, odometry: {experimental: {in_flight: {passes: 0}}}}\n",
+       "odometry.experimental.in_flight.passes"},
   };
   for (const Bad& c : cases) {
     SwarmManifest m;

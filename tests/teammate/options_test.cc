@@ -23,9 +23,10 @@ TEST(TeammateDetectorOptions, ReadsTheTeammateSection) {
   config::ConfigFile file;
   ASSERT_TRUE(config::ConfigFile::Parse("teammate:\n"
                                         "  clustering: {min_reflectivity: 240, max_object_size_m: 0.5}\n"
-                                        "  excitation: {min_second_singular_value_m2: 12}\n"
-                                        "  temporary:\n"
-                                        "    filter: {lidar_position_sigma_m: 0.05}\n",
+                                        "  experimental:\n"
+                                        "    excitation: {min_second_singular_value_m2: 12}\n"
+                                        "    temporary:\n"
+                                        "      filter: {lidar_position_sigma_m: 0.05}\n",
                                         "t.yaml", &file)
                   .ok());
   TeammateDetectorOptions options;
@@ -39,11 +40,12 @@ TEST(TeammateDetectorOptions, ReadsTheTeammateSection) {
 
 TEST(TeammateDetectorOptions, RejectsBadValuesNamingTheKey) {
   config::ConfigFile file;
-  ASSERT_TRUE(config::ConfigFile::Parse("teammate:\n  clustering: {min_range_m: 30}\n", "t.yaml", &file).ok());
+  ASSERT_TRUE(config::ConfigFile::Parse("teammate:\n  clustering: {experimental: {min_range_m: 30}}\n",
+                                        "t.yaml", &file).ok());
   TeammateDetectorOptions options;
   const Status status = file.Read("teammate", &options);
   ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("teammate.clustering.min_range_m"), std::string::npos)
+  EXPECT_NE(status.message().find("teammate.clustering.experimental.min_range_m"), std::string::npos)
       << status.message();
 
   TeammateDetectorOptions bad;

@@ -233,8 +233,9 @@ TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
       "  - name: a\n"
       "    bag: a.bag\n"
       "    sensor_preset: " + presets + "livox_mid360.yaml\n"
-      "    odometry: {estimator: window, window: {size: 7, linear_solver: sparse_normal_cholesky,\n"
-      "                                          reassociate_all_scans: false}}\n"
+      "    odometry: {estimator: window,\n"
+      "               window: {size: 7, experimental: {linear_solver: sparse_normal_cholesky,\n"
+      "                                                reassociate_all_scans: false}}}\n"
       "  - name: b\n"
       "    bag: b.bag\n"
       "    sensor_preset: " + presets + "livox_avia.yaml\n";

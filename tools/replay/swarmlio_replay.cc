@@ -52,10 +52,11 @@ DEFINE_int32(window_size, 0,
 DEFINE_string(window_linear_solver, "",
               "linear solver of the window for every drone: dense_normal_cholesky | dense_qr | "
               "dense_schur | sparse_normal_cholesky; default: each drone's "
-              "odometry.window.linear_solver");
+              "odometry.window.experimental.linear_solver");
 DEFINE_string(window_reassociate, "",
               "all | newest: re-associate every scan of the window at each iteration, or only "
-              "the newest (default: each drone's odometry.window.reassociate_all_scans)");
+              "the newest (default: each drone's "
+              "odometry.window.experimental.reassociate_all_scans)");
 DEFINE_string(received_packets, "",
               "offline re-run of live drones (docs/online.md): name=<name>_received.bin,... "
               "those drones receive exactly the recorded datagrams at their recorded arrival "

@@ -89,7 +89,9 @@ Status ConfigFile::Read(const std::string& section, Options* options) const {
     if (!error.ok()) return MakeReadError(error);
   }
   const std::string invalid = candidate.Validate();
-  if (!invalid.empty()) return MakeValidationError(section, invalid);
+  if (!invalid.empty()) {
+    return MakeValidationError(section, internal::ResolveMessageKey(candidate, invalid));
+  }
   *options = std::move(candidate);
   return Status::Ok();
 }

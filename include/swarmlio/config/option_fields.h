@@ -29,6 +29,26 @@
 //     v("dropout_probability", dropout_probability, FieldSpec::InRange(0, 1, "", "..."));
 //   }
 //
+// Research toggles and tuning knobs that users rarely set go into a field
+// group: a nested YAML map with no C++ sub-struct of its own. The fields stay
+// members of the struct; only the YAML path changes:
+//
+//   template <class Visitor> void VisitFields(Visitor&& v) {
+//     v("fuse_active", fuse_active, FieldSpec::Doc("..."));   // swarm.fuse_active
+//     config::VisitExperimental(v, [&](auto& x) {              // swarm.experimental.gate_sigma
+//       x("gate_sigma", gate_sigma, FieldSpec::Positive("", "..."));
+//     });
+//   }
+//
+// A group is visited like a nested options struct (FieldGroup has
+// VisitFields() and Validate()), so every visitor that handles nested structs
+// handles it. A struct visits at most one group of a given name (inline
+// extensions included). The loader reports a grouped key found at the
+// struct's own level as moved ("swarm.gate_sigma: moved to
+// swarm.experimental.gate_sigma"). Validate() messages name a grouped field
+// by its C++ path ("clock_sync.window_s", as code sets it); ConfigFile::Read
+// gives it its YAML path ("clock_sync.experimental.window_s").
+//
 // Loading from YAML: config/config_file.h. Rendering as documented YAML:
 // config/dump_options.h.
 //
@@ -149,6 +169,57 @@ inline std::string IndexKey(const std::string& key, size_t i) {
   return key + "[" + std::to_string(i) + "]";
 }
 
+template <class Options>
+std::string ValidateFields(const Options& options);
+
+/// A named group of fields of the enclosing struct, visited as a nested YAML
+/// map (see the top of this file). `Body` is a callable taking the visitor:
+/// `[&](auto& x) { x("key", member, spec); ... }`. Only a view: it refers to
+/// the enclosing struct's members and lives for one VisitFields() call.
+template <class Body>
+class FieldGroup {
+ public:
+  explicit FieldGroup(Body body) : body_(std::move(body)) {}
+
+  template <class V>
+  void VisitFields(V&& v) {
+    body_(v);
+  }
+  /// Range checks of the grouped fields ("key: reason", key relative to the group).
+  /// (ValidateFields of the enclosing struct checks them without the group's name.)
+  std::string Validate() const { return ValidateFields(*this); }
+
+ private:
+  Body body_;
+};
+
+/// True for FieldGroup (a group of fields, not a struct of its own).
+template <class T>
+struct IsFieldGroup : std::false_type {};
+template <class Body>
+struct IsFieldGroup<FieldGroup<Body>> : std::true_type {};
+
+/// YAML key of the group that holds a struct's research and tuning fields.
+inline constexpr const char* kExperimentalKey = "experimental";
+
+/// Visits the fields that `body` visits as the group `name` of `v`'s struct.
+template <class Visitor, class Body>
+void VisitGroup(Visitor& v, const char* name, const FieldSpec& spec, Body&& body) {
+  FieldGroup<std::decay_t<Body>> group(std::forward<Body>(body));
+  v(name, group, spec);
+}
+
+/// Visits the fields that `body` visits as the struct's `experimental:` map:
+/// research toggles and tuning knobs, loaded, validated and dumped like any
+/// other key but kept out of the short user-facing list.
+template <class Visitor, class Body>
+void VisitExperimental(Visitor& v, Body&& body) {
+  VisitGroup(v, kExperimentalKey,
+             FieldSpec::Doc("research and tuning keys (docs/configuration.md): the defaults are "
+                            "the tested values"),
+             std::forward<Body>(body));
+}
+
 namespace internal {
 
 /// Prefixes a Validate() message ("key: reason") with `prefix` + ".".
@@ -214,6 +285,9 @@ class RangeChecker {
       for (size_t i = 0; i < field.size() && error_.empty(); ++i) {
         error_ = CheckScalar(IndexKey(full, i), field[i], spec);
       }
+    } else if constexpr (IsFieldGroup<T>::value) {
+      (void)spec;
+      field.VisitFields(*this);  // no level of its own: keys keep their C++ path
     } else if constexpr (IsOptionsStruct<T>::value) {
       (void)spec;
       error_ = PrefixError(full, field.Validate());

@@ -101,8 +101,10 @@ struct ImuPropagatorOptions {
   void VisitFields(V&& v) {
     using config::FieldSpec;
     v("process_noise", process_noise);
-    v("max_gap_s", max_gap_s,
-      FieldSpec::Positive("s", "largest IMU interval that is propagated").WithMax(10.0));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("max_gap_s", max_gap_s,
+        FieldSpec::Positive("s", "largest IMU interval that is propagated").WithMax(10.0));
+    });
   }
 
   /// "" when valid, else "key: reason".

@@ -61,23 +61,25 @@ struct LocalMapOptions {
     using config::FieldSpec;
     v("leaf_size_m", leaf_size_m,
       FieldSpec::Positive("m", "insertion downsampling voxel (filter_size_map)").WithMax(100.0));
-    v("max_points_per_leaf", max_points_per_leaf,
-      FieldSpec::InRange(1.0, 1000.0, "", "points kept per leaf voxel; more are dropped"));
-    v("replace_range_ratio", replace_range_ratio,
-      FieldSpec::InRange(0.0, 1.0, "",
-                         "a full leaf's farthest-observed point is replaced by one observed from "
-                         "closer than this times its range; 0 = first come, first kept"));
-    v("cell_size_m", cell_size_m,
-      FieldSpec::InRange(0.0, 100.0, "m",
-                         "side of the hash-grid search cells; 0 = 4 * leaf_size_m (fastest "
-                         "in tools/bench/bench_local_map)"));
     v("half_extent_m", half_extent_m,
       FieldSpec::Positive("m", "points outside the cube of this half side around the drone "
                                "are removed (cube_side_length / 2)"));
-    v("prune_distance_m", prune_distance_m,
-      FieldSpec::AtLeast(0.0, "m", "the map is pruned when the drone moved this far"));
-    v("max_search_radius_m", max_search_radius_m,
-      FieldSpec::Positive("m", "nearest-neighbour queries ignore farther points"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("max_points_per_leaf", max_points_per_leaf,
+        FieldSpec::InRange(1.0, 1000.0, "", "points kept per leaf voxel; more are dropped"));
+      x("replace_range_ratio", replace_range_ratio,
+        FieldSpec::InRange(0.0, 1.0, "",
+                           "a full leaf's farthest-observed point is replaced by one observed from "
+                           "closer than this times its range; 0 = first come, first kept"));
+      x("cell_size_m", cell_size_m,
+        FieldSpec::InRange(0.0, 100.0, "m",
+                           "side of the hash-grid search cells; 0 = 4 * leaf_size_m (fastest "
+                           "in tools/bench/bench_local_map)"));
+      x("prune_distance_m", prune_distance_m,
+        FieldSpec::AtLeast(0.0, "m", "the map is pruned when the drone moved this far"));
+      x("max_search_radius_m", max_search_radius_m,
+        FieldSpec::Positive("m", "nearest-neighbour queries ignore farther points"));
+    });
   }
 
   /// cell_size_m, or 4 * leaf_size_m when it is 0.

@@ -70,28 +70,30 @@ struct OdometryOptions {
     v("initialization", initialization,
       FieldSpec::Doc("static (start at rest, default) or in_flight (velocity and gravity from "
                      "the first LiDAR scans; for a late join or a restart while flying)"));
-    v("imu_init", imu_init);
-    v("in_flight", in_flight);
     v("propagation", propagation);
     v("preprocess", preprocess);
     v("map", map);
-    v("association", association);
-    v("update", update);
     v("window", window);
     v("imu_time_offset_s", imu_time_offset_s,
       FieldSpec::InRange(-1.0, 1.0, "s", "subtracted from IMU stamps (IMU clock minus LiDAR clock)"));
-    v("min_scan_points", min_scan_points,
-      FieldSpec::InRange(1.0, 1e6, "", "fewer preprocessed points: propagate only, no update"));
-    v("max_queued_scans", max_queued_scans,
-      FieldSpec::InRange(1.0, 1000.0, "", "scans waiting for IMU data before the oldest is dropped"));
-    v("output_registered_scan", output_registered_scan,
-      FieldSpec::Doc("keep the registered scan (G frame) in each per-scan output"));
-    v("seed_map_from_static_start", seed_map_from_static_start,
-      FieldSpec::Doc("insert the scans inside the static IMU-initialization window into the map "
-                     "at the initial pose"));
-    v("insert_matched_points", insert_matched_points,
-      FieldSpec::Doc("also insert the scan points matched to a map plane (FAST-LIO2); false: "
-                     "only the points the map does not explain"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("imu_init", imu_init);
+      x("in_flight", in_flight);
+      x("association", association);
+      x("update", update);
+      x("min_scan_points", min_scan_points,
+        FieldSpec::InRange(1.0, 1e6, "", "fewer preprocessed points: propagate only, no update"));
+      x("max_queued_scans", max_queued_scans,
+        FieldSpec::InRange(1.0, 1000.0, "", "scans waiting for IMU data before the oldest is dropped"));
+      x("output_registered_scan", output_registered_scan,
+        FieldSpec::Doc("keep the registered scan (G frame) in each per-scan output"));
+      x("seed_map_from_static_start", seed_map_from_static_start,
+        FieldSpec::Doc("insert the scans inside the static IMU-initialization window into the map "
+                       "at the initial pose"));
+      x("insert_matched_points", insert_matched_points,
+        FieldSpec::Doc("also insert the scan points matched to a map plane (FAST-LIO2); false: "
+                       "only the points the map does not explain"));
+    });
   }
 
   /// "" when valid, else "key: reason".

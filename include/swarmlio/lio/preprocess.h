@@ -52,18 +52,20 @@ struct PreprocessOptions {
   template <class V>
   void VisitFields(V&& v) {
     using config::FieldSpec;
-    v("blind_range_m", blind_range_m, FieldSpec::AtLeast(0.0, "m", "closer points are dropped"));
-    v("max_range_m", max_range_m, FieldSpec::Positive("m", "farther points are dropped"));
     v("point_stride", point_stride,
       FieldSpec::InRange(1.0, 1000.0, "", "keep every n-th valid point (point_filter_num)"));
-    v("num_lines", num_lines,
-      FieldSpec::InRange(0.0, 256.0, "", "keep points with line < num_lines; 0 disables"));
-    v("livox_tag_filter", livox_tag_filter,
-      FieldSpec::Doc("keep only Livox single / first returns (tag bits 5:4 = 0 or 1)"));
-    v("livox_reject_noise", livox_reject_noise,
-      FieldSpec::Doc("drop Livox points flagged as spatial noise (tag bits 1:0 != 0)"));
     v("voxel_leaf_size_m", voxel_leaf_size_m,
       FieldSpec::InRange(0.0, 100.0, "m", "downsampling voxel (filter_size_surf); 0 = off"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("blind_range_m", blind_range_m, FieldSpec::AtLeast(0.0, "m", "closer points are dropped"));
+      x("max_range_m", max_range_m, FieldSpec::Positive("m", "farther points are dropped"));
+      x("num_lines", num_lines,
+        FieldSpec::InRange(0.0, 256.0, "", "keep points with line < num_lines; 0 disables"));
+      x("livox_tag_filter", livox_tag_filter,
+        FieldSpec::Doc("keep only Livox single / first returns (tag bits 5:4 = 0 or 1)"));
+      x("livox_reject_noise", livox_reject_noise,
+        FieldSpec::Doc("drop Livox points flagged as spatial noise (tag bits 1:0 != 0)"));
+    });
   }
 
   /// "" when valid, else "key: reason".

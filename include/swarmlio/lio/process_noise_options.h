@@ -46,10 +46,12 @@ struct ProcessNoiseOptions {
       FieldSpec::InRange(0.0, 1.0, "(rad/s^2)^2", "gyro bias random-walk variance"));
     v("accel_bias_cov_m2_s6", accel_bias_cov_m2_s6,
       FieldSpec::InRange(0.0, 1.0, "(m/s^3)^2", "accelerometer bias random-walk variance"));
-    v("teammate_rotation_cov_rad2_s2", teammate_rotation_cov_rad2_s2,
-      FieldSpec::InRange(0.0, 1.0, "(rad/s)^2", "global-extrinsic rotation random walk (n_R)"));
-    v("teammate_translation_cov_m2_s2", teammate_translation_cov_m2_s2,
-      FieldSpec::InRange(0.0, 100.0, "(m/s)^2", "global-extrinsic translation random walk (n_p)"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("teammate_rotation_cov_rad2_s2", teammate_rotation_cov_rad2_s2,
+        FieldSpec::InRange(0.0, 1.0, "(rad/s)^2", "global-extrinsic rotation random walk (n_R)"));
+      x("teammate_translation_cov_m2_s2", teammate_translation_cov_m2_s2,
+        FieldSpec::InRange(0.0, 100.0, "(m/s)^2", "global-extrinsic translation random walk (n_p)"));
+    });
   }
 
   /// "" when valid, else "key: reason".

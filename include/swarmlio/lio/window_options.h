@@ -85,21 +85,23 @@ struct WindowOptions {
   void VisitFields(V&& v) {
     using config::FieldSpec;
     v("size", size, FieldSpec::InRange(1.0, 100.0, "scans", "K: scan states in the window"));
-    v("max_iterations", max_iterations,
-      FieldSpec::InRange(1.0, 100.0, "", "outer iterations (re-association + Gauss-Newton step)"));
-    v("reassociate_all_scans", reassociate_all_scans,
-      FieldSpec::Doc("re-associate every scan of the window at each iteration (false: only "
-                     "the newest; the others keep their correspondences)"));
-    v("linear_solver", linear_solver,
-      FieldSpec::Doc("Ceres linear solver of the Gauss-Newton step"));
-    v("gravity_stddev_floor_m_s2", gravity_stddev_floor_m_s2,
-      FieldSpec::Positive("m/s^2", "1-sigma of the gravity change between two window states")
-          .WithMax(1.0));
-    v("reintegrate_gyro_bias_rad_s", reintegrate_gyro_bias_rad_s,
-      FieldSpec::Positive("rad/s", "preintegrate again when the gyro bias moved this far"));
-    v("reintegrate_accel_bias_m_s2", reintegrate_accel_bias_m_s2,
-      FieldSpec::Positive("m/s^2", "preintegrate again when the accel bias moved this far"));
-    v("marginalization", marginalization);
+    config::VisitExperimental(v, [&](auto& x) {
+      x("max_iterations", max_iterations,
+        FieldSpec::InRange(1.0, 100.0, "", "outer iterations (re-association + Gauss-Newton step)"));
+      x("reassociate_all_scans", reassociate_all_scans,
+        FieldSpec::Doc("re-associate every scan of the window at each iteration (false: only "
+                       "the newest; the others keep their correspondences)"));
+      x("linear_solver", linear_solver,
+        FieldSpec::Doc("Ceres linear solver of the Gauss-Newton step"));
+      x("gravity_stddev_floor_m_s2", gravity_stddev_floor_m_s2,
+        FieldSpec::Positive("m/s^2", "1-sigma of the gravity change between two window states")
+            .WithMax(1.0));
+      x("reintegrate_gyro_bias_rad_s", reintegrate_gyro_bias_rad_s,
+        FieldSpec::Positive("rad/s", "preintegrate again when the gyro bias moved this far"));
+      x("reintegrate_accel_bias_m_s2", reintegrate_accel_bias_m_s2,
+        FieldSpec::Positive("m/s^2", "preintegrate again when the accel bias moved this far"));
+      x("marginalization", marginalization);
+    });
   }
 
   /// "" when valid, else "key: reason".

@@ -108,44 +108,46 @@ struct ClockSyncOptions {
     v("exchange", exchange,
       FieldSpec::Doc("state_echo (timestamps in the state broadcasts) or requests (TimeSync "
                      "packets per teammate)"));
-    v("echo_period_s", echo_period_s,
-      FieldSpec::InRange(0.01, 3600.0, "s", "state echo: a teammate's state echoed at most this often"));
-    v("unsettled_echo_period_s", unsettled_echo_period_s,
-      FieldSpec::InRange(0.01, 3600.0, "s",
-                         "state echo: ... and this often while the offset is not settled"));
-    v("max_echoes_per_state", max_echoes_per_state,
-      FieldSpec::InRange(1, EgoStateMessage::kMaxEchoes, "", "state echo: echoes per EgoState"));
-    v("max_echo_age_s", max_echo_age_s,
-      FieldSpec::InRange(0.001, 0.5, "s", "state echo: oldest teammate state that is echoed"));
-    v("request_period_s", request_period_s,
-      FieldSpec::Positive("s", "interval between requests to one teammate").WithMax(3600.0));
-    v("settled_request_period_s", settled_request_period_s,
-      FieldSpec::Positive("s", "interval between requests once the offset is settled").WithMax(3600.0));
-    v("settled_std_s", settled_std_s,
-      FieldSpec::InRange(0.0, 1.0, "s", "offset std below which requests slow down (0 = never)"));
-    v("burst_requests", burst_requests,
-      FieldSpec::InRange(0, 64, "", "requests at burst_period_s when a teammate appears"));
-    v("burst_period_s", burst_period_s,
-      FieldSpec::Positive("s", "interval between the burst requests").WithMax(3600.0));
-    v("response_timeout_s", response_timeout_s,
-      FieldSpec::Positive("s", "responses arriving later are dropped").WithMax(60.0));
-    v("max_outstanding_requests", max_outstanding_requests,
-      FieldSpec::InRange(1, 64, "", "requests in flight per teammate"));
-    v("window_samples", window_samples,
-      FieldSpec::InRange(2, 4096, "", "exchanges kept per teammate for the fit"));
-    v("window_s", window_s,
-      FieldSpec::Positive("s", "exchanges older than this are dropped").WithMax(86400.0));
-    v("min_samples", min_samples,
-      FieldSpec::InRange(1, 4096, "", "exchanges before the estimate counts as converged"));
-    v("timestamp_noise_s", timestamp_noise_s,
-      FieldSpec::Positive("s", "floor of one exchange's offset std (stamping noise)").WithMax(1.0));
-    v("drift_prior_ppm", drift_prior_ppm,
-      FieldSpec::Positive("ppm", "prior std of the relative drift of two clocks").WithMax(1e5));
-    v("step_reset_samples", step_reset_samples,
-      FieldSpec::InRange(1, 64, "", "consecutive contradicting exchanges that restart the fit"));
-    v("report_period_s", report_period_s,
-      FieldSpec::InRange(0.0, 3600.0, "s",
-                         "our offset estimate sent to each teammate at most this often (0 = never)"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("echo_period_s", echo_period_s,
+        FieldSpec::InRange(0.01, 3600.0, "s", "state echo: a teammate's state echoed at most this often"));
+      x("unsettled_echo_period_s", unsettled_echo_period_s,
+        FieldSpec::InRange(0.01, 3600.0, "s",
+                           "state echo: ... and this often while the offset is not settled"));
+      x("max_echoes_per_state", max_echoes_per_state,
+        FieldSpec::InRange(1, EgoStateMessage::kMaxEchoes, "", "state echo: echoes per EgoState"));
+      x("max_echo_age_s", max_echo_age_s,
+        FieldSpec::InRange(0.001, 0.5, "s", "state echo: oldest teammate state that is echoed"));
+      x("request_period_s", request_period_s,
+        FieldSpec::Positive("s", "interval between requests to one teammate").WithMax(3600.0));
+      x("settled_request_period_s", settled_request_period_s,
+        FieldSpec::Positive("s", "interval between requests once the offset is settled").WithMax(3600.0));
+      x("settled_std_s", settled_std_s,
+        FieldSpec::InRange(0.0, 1.0, "s", "offset std below which requests slow down (0 = never)"));
+      x("burst_requests", burst_requests,
+        FieldSpec::InRange(0, 64, "", "requests at burst_period_s when a teammate appears"));
+      x("burst_period_s", burst_period_s,
+        FieldSpec::Positive("s", "interval between the burst requests").WithMax(3600.0));
+      x("response_timeout_s", response_timeout_s,
+        FieldSpec::Positive("s", "responses arriving later are dropped").WithMax(60.0));
+      x("max_outstanding_requests", max_outstanding_requests,
+        FieldSpec::InRange(1, 64, "", "requests in flight per teammate"));
+      x("window_samples", window_samples,
+        FieldSpec::InRange(2, 4096, "", "exchanges kept per teammate for the fit"));
+      x("window_s", window_s,
+        FieldSpec::Positive("s", "exchanges older than this are dropped").WithMax(86400.0));
+      x("min_samples", min_samples,
+        FieldSpec::InRange(1, 4096, "", "exchanges before the estimate counts as converged"));
+      x("timestamp_noise_s", timestamp_noise_s,
+        FieldSpec::Positive("s", "floor of one exchange's offset std (stamping noise)").WithMax(1.0));
+      x("drift_prior_ppm", drift_prior_ppm,
+        FieldSpec::Positive("ppm", "prior std of the relative drift of two clocks").WithMax(1e5));
+      x("step_reset_samples", step_reset_samples,
+        FieldSpec::InRange(1, 64, "", "consecutive contradicting exchanges that restart the fit"));
+      x("report_period_s", report_period_s,
+        FieldSpec::InRange(0.0, 3600.0, "s",
+                           "our offset estimate sent to each teammate at most this often (0 = never)"));
+    });
   }
 
   std::string Validate() const;

@@ -47,20 +47,22 @@ struct LinkOptions {
       FieldSpec::InRange(0.0, 10.0, "s", "delay standard deviation (truncated at 0 delay)"));
     v("loss_probability", loss_probability,
       FieldSpec::InRange(0.0, 1.0, "", "probability that a packet is lost"));
-    v("duplicate_probability", duplicate_probability,
-      FieldSpec::InRange(0.0, 1.0, "", "probability that a packet is delivered twice"));
-    v("reorder_probability", reorder_probability,
-      FieldSpec::InRange(0.0, 1.0, "", "probability of an extra delay that reorders packets"));
-    v("reorder_delay_max_s", reorder_delay_max_s,
-      FieldSpec::InRange(0.0, 10.0, "s", "extra delay is uniform in [0, this]"));
-    v("skip_delay_probability", skip_delay_probability,
-      FieldSpec::InRange(0.0, 1.0, "",
-                         "probability that a packet skips latency_mean_s (netem's reorder)"));
     v("bandwidth_bytes_per_s", bandwidth_bytes_per_s,
       FieldSpec::AtLeast(0.0, "B/s", "link capacity, 0 for unlimited"));
-    v("max_queue_delay_s", max_queue_delay_s,
-      FieldSpec::Positive("s", "with a bandwidth cap, packets that would queue longer are dropped")
-          .WithMax(60.0));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("duplicate_probability", duplicate_probability,
+        FieldSpec::InRange(0.0, 1.0, "", "probability that a packet is delivered twice"));
+      x("reorder_probability", reorder_probability,
+        FieldSpec::InRange(0.0, 1.0, "", "probability of an extra delay that reorders packets"));
+      x("reorder_delay_max_s", reorder_delay_max_s,
+        FieldSpec::InRange(0.0, 10.0, "s", "extra delay is uniform in [0, this]"));
+      x("skip_delay_probability", skip_delay_probability,
+        FieldSpec::InRange(0.0, 1.0, "",
+                           "probability that a packet skips latency_mean_s (netem's reorder)"));
+      x("max_queue_delay_s", max_queue_delay_s,
+        FieldSpec::Positive("s", "with a bandwidth cap, packets that would queue longer are dropped")
+            .WithMax(60.0));
+    });
   }
 
   std::string Validate() const { return config::ValidateFields(*this); }

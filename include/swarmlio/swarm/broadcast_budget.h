@@ -64,16 +64,18 @@ struct BroadcastBudgetOptions {
     using config::FieldSpec;
     v("max_bytes_per_s", max_bytes_per_s,
       FieldSpec::InRange(0.0, 1e9, "B/s", "bytes on the wire per second, headers included (0 = unlimited)"));
-    v("burst_s", burst_s, FieldSpec::InRange(0.0, 60.0, "s", "credit saved at most this many seconds"));
-    v("ip_udp_header_bytes", ip_udp_header_bytes,
-      FieldSpec::InRange(0, 128, "B", "IP/UDP header bytes per datagram"));
-    v("max_extrinsic_entries_per_broadcast", max_extrinsic_entries_per_broadcast,
-      FieldSpec::InRange(0, 255, "", "T_Gi_Gj entries per broadcast (0 = as many as the budget affords)"));
-    v("urgent_echoes_per_state", urgent_echoes_per_state,
-      FieldSpec::InRange(0, 8, "", "echoes for unconverged clock offsets ranked above the observations"));
-    v("extrinsic_overdue_s", extrinsic_overdue_s,
-      FieldSpec::InRange(0.0, 3600.0, "s",
-                         "an entry not sent for this long goes out like a new one (0 = never)"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("burst_s", burst_s, FieldSpec::InRange(0.0, 60.0, "s", "credit saved at most this many seconds"));
+      x("ip_udp_header_bytes", ip_udp_header_bytes,
+        FieldSpec::InRange(0, 128, "B", "IP/UDP header bytes per datagram"));
+      x("max_extrinsic_entries_per_broadcast", max_extrinsic_entries_per_broadcast,
+        FieldSpec::InRange(0, 255, "", "T_Gi_Gj entries per broadcast (0 = as many as the budget affords)"));
+      x("urgent_echoes_per_state", urgent_echoes_per_state,
+        FieldSpec::InRange(0, 8, "", "echoes for unconverged clock offsets ranked above the observations"));
+      x("extrinsic_overdue_s", extrinsic_overdue_s,
+        FieldSpec::InRange(0.0, 3600.0, "s",
+                           "an entry not sent for this long goes out like a new one (0 = never)"));
+    });
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };

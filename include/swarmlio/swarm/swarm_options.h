@@ -148,48 +148,50 @@ struct SwarmOptions {
     v("fuse_passive", fuse_passive, FieldSpec::Doc("fuse passive observations (j saw me)"));
     v("fuse_gravity", fuse_gravity,
       FieldSpec::Doc("fuse the teammates' broadcast gravity with the own (tilt of T_Gi_Gj)"));
-    v("gravity_alignment_sigma_m_s2", gravity_alignment_sigma_m_s2,
-      FieldSpec::Positive("m/s^2", "1-sigma added to a teammate's gravity covariance"));
-    v("observation_information_share", observation_information_share,
-      FieldSpec::InRange(0.01, 1.0, "", "share of a mutual observation's information per use (active, passive)"));
-    v("time_compensation", time_compensation,
-      FieldSpec::Doc("predict teammate states / shift passive observations to the update time"));
     v("synchronize_clocks", synchronize_clocks,
       FieldSpec::Doc("estimate teammates' clock offsets online and map their stamps to the own clock"));
     v("clock_sync", clock_sync, FieldSpec::Doc("clock synchronisation (docs/network.md)"));
-    v("max_message_age_s", max_message_age_s,
-      FieldSpec::Positive("s", "teammate messages older than this are not used"));
     v("teammate_timeout_s", teammate_timeout_s,
       FieldSpec::Positive("s", "unseen and unheard this long: removed from the state"));
-    v("init_translation_sigma_floor_m", init_translation_sigma_floor_m,
-      FieldSpec::Positive("m", "smallest initial 1-sigma of p_Gj_in_Gi"));
-    v("init_translation_sigma_per_residual", init_translation_sigma_per_residual,
-      FieldSpec::Positive("", "initial 1-sigma of p_Gj_in_Gi per metre of match residual"));
-    v("init_rotation_sigma_floor_rad", init_rotation_sigma_floor_rad,
-      FieldSpec::Positive("rad", "smallest initial 1-sigma of R_Gi_Gj"));
-    v("gate_sigma", gate_sigma, FieldSpec::AtLeast(0.0, "", "Mahalanobis gate (0 = off)"));
-    v("degeneracy_policy", degeneracy_policy,
-      FieldSpec::Doc("consider_extrinsics | freeze_extrinsics | estimate_all, after a "
-                     "degenerate scan"));
-    v("skip_degenerate_teammates", skip_degenerate_teammates,
-      FieldSpec::Doc("do not fuse observations involving a teammate that reports degeneracy"));
-    v("repeat_observations", repeat_observations,
-      FieldSpec::Doc("none | degenerate_teammates | all: observations sent again with the next state"));
-    v("mutual_identification", mutual_identification,
-      FieldSpec::Doc("add a teammate that identified this drone, with the inverse of its T_Gj_Gi"));
-    v("graph_identification", graph_identification,
-      FieldSpec::Doc("add a teammate that a known teammate identified, through its T_Gj_Gk"));
-    v("graph_through_derived", graph_through_derived,
-      FieldSpec::Doc("a graph-derived teammate may relay once the teammates it came through left or "
-                     "its block was fused graph_derived_min_observations times"));
-    v("graph_derived_min_observations", graph_derived_min_observations,
-      FieldSpec::AtLeast(0, "", "own observations fused into a graph-derived block before it may relay"));
     v("extrinsic_broadcast_period_s", extrinsic_broadcast_period_s,
       FieldSpec::AtLeast(0.0, "s", "broadcast the own T_Gi_Gj estimates this often (0 = never)"));
     v("broadcast_budget", broadcast_budget,
       FieldSpec::Doc("bytes on the wire per second and how the optional content shares them"));
     v("map_exclusion_radius_m", map_exclusion_radius_m,
       FieldSpec::Positive("m", "points this close to a tracked object stay out of the map"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("gravity_alignment_sigma_m_s2", gravity_alignment_sigma_m_s2,
+        FieldSpec::Positive("m/s^2", "1-sigma added to a teammate's gravity covariance"));
+      x("observation_information_share", observation_information_share,
+        FieldSpec::InRange(0.01, 1.0, "", "share of a mutual observation's information per use (active, passive)"));
+      x("time_compensation", time_compensation,
+        FieldSpec::Doc("predict teammate states / shift passive observations to the update time"));
+      x("max_message_age_s", max_message_age_s,
+        FieldSpec::Positive("s", "teammate messages older than this are not used"));
+      x("init_translation_sigma_floor_m", init_translation_sigma_floor_m,
+        FieldSpec::Positive("m", "smallest initial 1-sigma of p_Gj_in_Gi"));
+      x("init_translation_sigma_per_residual", init_translation_sigma_per_residual,
+        FieldSpec::Positive("", "initial 1-sigma of p_Gj_in_Gi per metre of match residual"));
+      x("init_rotation_sigma_floor_rad", init_rotation_sigma_floor_rad,
+        FieldSpec::Positive("rad", "smallest initial 1-sigma of R_Gi_Gj"));
+      x("gate_sigma", gate_sigma, FieldSpec::AtLeast(0.0, "", "Mahalanobis gate (0 = off)"));
+      x("degeneracy_policy", degeneracy_policy,
+        FieldSpec::Doc("consider_extrinsics | freeze_extrinsics | estimate_all, after a "
+                       "degenerate scan"));
+      x("skip_degenerate_teammates", skip_degenerate_teammates,
+        FieldSpec::Doc("do not fuse observations involving a teammate that reports degeneracy"));
+      x("repeat_observations", repeat_observations,
+        FieldSpec::Doc("none | degenerate_teammates | all: observations sent again with the next state"));
+      x("mutual_identification", mutual_identification,
+        FieldSpec::Doc("add a teammate that identified this drone, with the inverse of its T_Gj_Gi"));
+      x("graph_identification", graph_identification,
+        FieldSpec::Doc("add a teammate that a known teammate identified, through its T_Gj_Gk"));
+      x("graph_through_derived", graph_through_derived,
+        FieldSpec::Doc("a graph-derived teammate may relay once the teammates it came through left or "
+                       "its block was fused graph_derived_min_observations times"));
+      x("graph_derived_min_observations", graph_derived_min_observations,
+        FieldSpec::AtLeast(0, "", "own observations fused into a graph-derived block before it may relay"));
+    });
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };

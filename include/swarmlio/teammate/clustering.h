@@ -34,18 +34,20 @@ struct ClusteringOptions {
     using config::FieldSpec;
     v("min_reflectivity", min_reflectivity,
       FieldSpec::InRange(0.0, 255.0, "", "reflectivity threshold calibrated on the tape (Livox 0-255)"));
-    v("min_range_m", min_range_m, FieldSpec::AtLeast(0.0, "m", "closer points are ignored"));
-    v("max_range_m", max_range_m, FieldSpec::Positive("m", "farther points are not clustered"));
-    v("cluster_tolerance_m", cluster_tolerance_m,
-      FieldSpec::Positive("m", "Euclidean clustering distance tolerance").WithMax(5.0));
-    v("min_cluster_points", min_cluster_points,
-      FieldSpec::InRange(1.0, 1e6, "", "smallest cluster kept"));
-    v("max_cluster_points", max_cluster_points,
-      FieldSpec::InRange(1.0, 1e7, "", "largest reflective cluster kept"));
-    v("max_region_points", max_region_points,
-      FieldSpec::InRange(1.0, 1e6, "", "nearest raw points kept in a predicted region"));
     v("max_object_size_m", max_object_size_m,
       FieldSpec::Positive("m", "clusters with a larger bounding-box diagonal are not drones"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("min_range_m", min_range_m, FieldSpec::AtLeast(0.0, "m", "closer points are ignored"));
+      x("max_range_m", max_range_m, FieldSpec::Positive("m", "farther points are not clustered"));
+      x("cluster_tolerance_m", cluster_tolerance_m,
+        FieldSpec::Positive("m", "Euclidean clustering distance tolerance").WithMax(5.0));
+      x("min_cluster_points", min_cluster_points,
+        FieldSpec::InRange(1.0, 1e6, "", "smallest cluster kept"));
+      x("max_cluster_points", max_cluster_points,
+        FieldSpec::InRange(1.0, 1e7, "", "largest reflective cluster kept"));
+      x("max_region_points", max_region_points,
+        FieldSpec::InRange(1.0, 1e6, "", "nearest raw points kept in a predicted region"));
+    });
   }
   std::string Validate() const {
     std::string error = config::ValidateFields(*this);

@@ -64,20 +64,22 @@ struct ObservationOptions {
     using config::FieldSpec;
     v("centroid_depth_offset_m", centroid_depth_offset_m,
       FieldSpec::InRange(0.0, 1.0, "m", "distance from the visible-surface centroid to the body origin"));
-    v("tape_half_length_m", tape_half_length_m,
-      FieldSpec::InRange(0.0, 1.0, "m", "half extent of the teammates' tape band along body x (0: unknown)"));
-    v("tape_half_width_m", tape_half_width_m,
-      FieldSpec::InRange(0.0, 1.0, "m", "half extent of the teammates' tape band along body y (0: unknown)"));
-    v("min_reflective_points", min_reflective_points,
-      FieldSpec::AtLeast(1.0, "", "tape returns needed to use the tape centroid"));
-    v("compensate_target_motion", compensate_target_motion,
-      FieldSpec::Doc("move the centroid from its capture time to the scan stamp"));
-    v("range_sigma_m", range_sigma_m, FieldSpec::Positive("m", "1-sigma along the line of sight"));
-    v("lateral_sigma_m", lateral_sigma_m,
-      FieldSpec::Positive("m", "1-sigma across the line of sight at zero range"));
-    v("lateral_sigma_per_range_rad", lateral_sigma_per_range_rad,
-      FieldSpec::AtLeast(0.0, "rad", "growth of the lateral 1-sigma with range"));
-    v("min_range_m", min_range_m, FieldSpec::AtLeast(0.0, "m", "closer clusters are not reported"));
+    config::VisitExperimental(v, [&](auto& x) {
+      x("tape_half_length_m", tape_half_length_m,
+        FieldSpec::InRange(0.0, 1.0, "m", "half extent of the teammates' tape band along body x (0: unknown)"));
+      x("tape_half_width_m", tape_half_width_m,
+        FieldSpec::InRange(0.0, 1.0, "m", "half extent of the teammates' tape band along body y (0: unknown)"));
+      x("min_reflective_points", min_reflective_points,
+        FieldSpec::AtLeast(1.0, "", "tape returns needed to use the tape centroid"));
+      x("compensate_target_motion", compensate_target_motion,
+        FieldSpec::Doc("move the centroid from its capture time to the scan stamp"));
+      x("range_sigma_m", range_sigma_m, FieldSpec::Positive("m", "1-sigma along the line of sight"));
+      x("lateral_sigma_m", lateral_sigma_m,
+        FieldSpec::Positive("m", "1-sigma across the line of sight at zero range"));
+      x("lateral_sigma_per_range_rad", lateral_sigma_per_range_rad,
+        FieldSpec::AtLeast(0.0, "rad", "growth of the lateral 1-sigma with range"));
+      x("min_range_m", min_range_m, FieldSpec::AtLeast(0.0, "m", "closer clusters are not reported"));
+    });
   }
   std::string Validate() const { return config::ValidateFields(*this); }
   /// The band model of the file comment is configured.

@@ -30,13 +30,15 @@ struct TeammateDetectorOptions {
   template <class V>
   void VisitFields(V&& v) {
     v("clustering", clustering);
-    v("association", association);
-    v("temporary", temporary);
-    v("excitation", excitation);
-    v("matching", matching);
-    v("teammate", teammate);
     v("observation", observation);
-    v("removal", removal);
+    config::VisitExperimental(v, [&](auto& x) {
+      x("association", association);
+      x("temporary", temporary);
+      x("excitation", excitation);
+      x("matching", matching);
+      x("teammate", teammate);
+      x("removal", removal);
+    });
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };
