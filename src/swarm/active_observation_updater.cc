@@ -25,7 +25,7 @@ void ActiveObservationUpdater::AddTerms(const UpdaterScan& scan, ObservationGate
       ++report->skipped_degenerate;
       continue;
     }
-    const double age = static_cast<double>(scan.t_k - m.stamp_ns) * 1e-9;
+    const double age = Seconds(scan.t_k - m.stamp_ns);
     if (std::abs(age) > so.max_message_age_s) {
       ++report->rejected;
       ++counters_->observations_rejected;

@@ -43,8 +43,6 @@
 namespace swarmlio::swarm {
 namespace {
 
-inline double Seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
-
 // Wire bytes of a GlobalExtrinsic broadcast of n entries (split into
 // messages of at most kMaxEntries, each with its own header and gravity).
 size_t ExtrinsicWireBytes(const BroadcastBudget& budget, size_t n) {

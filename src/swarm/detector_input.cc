@@ -2,13 +2,9 @@
 
 #include <algorithm>
 
+#include "teammate_state.h"
+
 namespace swarmlio::swarm::internal {
-namespace {
-
-inline double Seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
-
-}  // namespace
-
 Status DetectorInput::Make(const LidarScan& raw, int64_t t_k, const std::vector<ImuPose>& poses,
                            const SwarmState& x, const teammate::ScanResult& last_detection,
                            double last_detection_s, std::vector<teammate::ScanPoint>* points) {

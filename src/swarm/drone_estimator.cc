@@ -18,8 +18,6 @@
 namespace swarmlio::swarm {
 namespace {
 
-inline double Seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
-
 double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -182,8 +180,8 @@ Status DroneEstimator::FrontEnd(lio::ScanContext* scan, lio::UpdateRequest* requ
   Eigen::Isometry3d T_Gi_bi = Eigen::Isometry3d::Identity();
   T_Gi_bi.linear() = x.ego.R_G_b();
   T_Gi_bi.translation() = x.ego.p_b_in_G;
-  SWARMLIO_RETURN_IF_ERROR(detector_->ProcessScan(Seconds(t_k), T_Gi_bi, p.points, &p.detection));
-  p.last_detection_s = Seconds(t_k);
+  SWARMLIO_RETURN_IF_ERROR(detector_->ProcessScan(internal::Seconds(t_k), T_Gi_bi, p.points, &p.detection));
+  p.last_detection_s = internal::Seconds(t_k);
 
   // State blocks: new teammates in, lost or restarted ones out.
   p.registry.UpdateBlocks(t_k, p.detection, &x, &scan->P, &p.report, &counters_);

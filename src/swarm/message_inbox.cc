@@ -128,7 +128,7 @@ void MessageInbox::OnState(const net::EgoStateMessage& received, int64_t arrival
   info.last_heard_ns = std::max(info.last_heard_ns, arrival_ns);
 
   teammate::TeammateOdometry odometry;
-  odometry.stamp_s = static_cast<double>(m.stamp_ns) * 1e-9;
+  odometry.stamp_s = Seconds(m.stamp_ns);
   odometry.drone_id = m.sender_id;
   odometry.p_bj_in_Gj = m.p_bj_in_Gj;
   odometry.q_Gj_bj = m.q_Gj_bj.normalized();
@@ -152,7 +152,7 @@ void MessageInbox::OnRestart(int j, int64_t arrival_ns) {
   // identification would compose them: off by its motion since its start).
   for (auto& [id, other] : teammates) other.identified.erase(j);
   info.taken_observation_stamps.clear();
-  to_.detector->RestartTeammate(j, static_cast<double>(arrival_ns) * 1e-9);
+  to_.detector->RestartTeammate(j, Seconds(arrival_ns));
   to_.registry->ForgetMutual(j);
   to_.passive->ForgetSender(j);
 }

@@ -32,7 +32,7 @@ void PassiveObservationUpdater::AddTerms(const UpdaterScan& scan, ObservationGat
       ++report->skipped_degenerate;
       continue;
     }
-    const double dt = static_cast<double>(p.stamp_ns - scan.t_k) * 1e-9;
+    const double dt = Seconds(p.stamp_ns - scan.t_k);
     if (std::abs(dt) > so.max_message_age_s) {
       ++report->rejected;
       ++counters_->observations_rejected;

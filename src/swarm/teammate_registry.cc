@@ -10,8 +10,6 @@
 namespace swarmlio::swarm::internal {
 namespace {
 
-inline double Seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
-
 IdentificationEvent Event(int id, int64_t t_k, const char* method, const GlobalExtrinsic& T) {
   IdentificationEvent event;
   event.drone_id = id;
