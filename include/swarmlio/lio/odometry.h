@@ -76,7 +76,8 @@ struct ScanOutput {
   int64_t scan_stamp_ns = 0;  // the scan's stamp (its first point time)
   int64_t stamp_ns = 0;       // the state's time: the scan end
   EgoState state;             // posterior (or prediction when not updated)
-  Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim> covariance;
+  Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim> covariance =
+      Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>::Zero();
   bool updated = false;           // false: map initialisation, too few points, failed update
   // The scan arrived while the in-flight initialization's passes ran and was
   // processed when they ended (docs/imu.md section 1b): its output came that
