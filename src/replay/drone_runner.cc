@@ -1,5 +1,6 @@
 #include "swarmlio/replay/drone_runner.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -116,6 +117,11 @@ Status DroneRunner::Restart() {
   return Status::Ok();
 }
 
+void DroneRunner::SkipScans(std::vector<int64_t> scan_stamps_ns) {
+  std::sort(scan_stamps_ns.begin(), scan_stamps_ns.end());
+  skip_scan_stamps_ns_ = std::move(scan_stamps_ns);
+}
+
 int64_t DroneRunner::next_stamp_ns() const { return next_.stamp_ns(); }
 
 Status DroneRunner::ReadNext() {
@@ -138,7 +144,13 @@ Status DroneRunner::Step() {
   if (const ImuSample* imu = next_.imu()) {
     Warn(estimator_->AddImu(*imu));
   } else if (const LidarScan* scan = next_.scan()) {
-    Warn(estimator_->AddScan(*scan));
+    // The live drone names a dropped scan by its record's stamp.
+    if (std::binary_search(skip_scan_stamps_ns_.begin(), skip_scan_stamps_ns_.end(),
+                           next_.stamp_ns())) {
+      ++skipped_scans_;
+    } else {
+      Warn(estimator_->AddScan(*scan));
+    }
   } else if (const PoseStamped* pose = next_.ground_truth()) {
     ground_truth_.push_back(*pose);
   }

@@ -72,10 +72,7 @@ Status SwarmReplay::OpenRecordedPackets(const ReplayOptions& options) {
   recorded_.resize(runners_.size());
   recording_damage_ = Status::Ok();
   for (const auto& [name, path] : options.received_packets) {
-    int id = -1;
-    for (size_t i = 0; i < runners_.size(); ++i) {
-      if (runners_[i]->input().name == name) id = static_cast<int>(i);
-    }
+    const int id = FindDrone(name);
     if (id < 0) {
       return Status::InvalidArgument("received_packets: no drone named '" + name +
                                      "' in the manifest");
@@ -85,6 +82,25 @@ Status SwarmReplay::OpenRecordedPackets(const ReplayOptions& options) {
     // A damaged log re-runs with its complete records; Run() reports it.
     if (recording_damage_.ok()) recording_damage_ = transport->damage();
     recorded_[id] = std::move(transport);
+  }
+  return Status::Ok();
+}
+
+int SwarmReplay::FindDrone(const std::string& name) const {
+  for (size_t i = 0; i < runners_.size(); ++i) {
+    if (runners_[i]->input().name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Status SwarmReplay::SkipDroppedScans(const ReplayOptions& options) {
+  for (const auto& [name, stamps_ns] : options.dropped_scans) {
+    const int id = FindDrone(name);
+    if (id < 0) {
+      return Status::InvalidArgument("dropped_scans: no drone named '" + name +
+                                     "' in the manifest");
+    }
+    runners_[id]->SkipScans(stamps_ns);
   }
   return Status::Ok();
 }
@@ -108,6 +124,7 @@ Status SwarmReplay::Broadcast(int drone, int64_t now_ns) {
 
 Status SwarmReplay::Run(const ReplayOptions& options) {
   SWARMLIO_RETURN_IF_ERROR(SetUpNetwork(options));
+  SWARMLIO_RETURN_IF_ERROR(SkipDroppedScans(options));
   std::vector<net::ReceivedMessage> inbox;
   Status first_error;
   ReplayProgress progress;

@@ -6,8 +6,9 @@
 // messages; the datagrams each one recorded, re-run offline through
 // SwarmReplay (--received_packets), must reproduce its trajectory: the
 // estimator thread delivers a message before the record at stamp s exactly
-// when its recorded arrival is <= s, as the replay loop does, so without
-// dropped scans the re-run is bit-identical (tolerance 1e-9 m).
+// when its recorded arrival is <= s, as the replay loop does, and the re-run
+// leaves out the scans the live run dropped (ReplayOptions::dropped_scans), so
+// it is bit-identical (tolerance 1e-9 m) whether or not scans were dropped.
 // A second test runs one drone on a racing fake clock: every scan is dropped
 // whole and counted, every IMU sample still reaches the estimator.
 #include <arpa/inet.h>
@@ -83,7 +84,9 @@ class CollectingSink : public LiveSink {
     scans.push_back(replay::ToScanRecord(output));
     latencies_ms.push_back(1e-6 * static_cast<double>(latency.latency_ns()));
   }
-  void OnScanDropped(int64_t /*stamp_ns*/, ScanDropReason /*reason*/) override { ++dropped; }
+  void OnScanDropped(int64_t stamp_ns, ScanDropReason /*reason*/) override {
+    dropped_stamps_ns.push_back(stamp_ns);
+  }
   void OnImuPose(const ImuRatePose& pose) override {
     if (imu_poses == 0) first_imu_ns = pose.stamp_ns;
     last_imu_ns = pose.stamp_ns;
@@ -92,7 +95,7 @@ class CollectingSink : public LiveSink {
 
   std::vector<replay::ScanRecord> scans;
   std::vector<double> latencies_ms;
-  int64_t dropped = 0;
+  std::vector<int64_t> dropped_stamps_ns;
   int64_t imu_poses = 0;
   int64_t first_imu_ns = 0;
   int64_t last_imu_ns = 0;
@@ -170,7 +173,9 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
   options.rate = kRate;
   if (!kSanitized) {
     // Generous: on a loaded 2-core machine the drones fall behind for a
-    // moment rather than drop scans, so the re-run comparison stays exact.
+    // moment rather than drop many scans, so they keep tracking at 10 Hz.
+    // Scans dropped all the same (seen: 8-11 of 240 with two builds running)
+    // are left out of the re-run, which stays exact.
     options.max_scan_backlog_s = 5.0;
     options.max_queued_scans = 100;
   }
@@ -220,6 +225,7 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
     ASSERT_GT(imu_span_s, 1.0);
     EXPECT_GE(static_cast<double>(sinks[i].imu_poses - 1) / imu_span_s, 195.0);
     offline.received_packets[name] = dir_->File(name + "_received.bin");
+    offline.dropped_scans[name] = sinks[i].dropped_stamps_ns;
     std::printf("%s live: %lld scans, %lld dropped, latency median %.2f ms p95 %.2f ms, "
                 "received %llu messages (%lld datagrams recorded), %lld IMU poses\n",
                 name.c_str(), static_cast<long long>(s.scans_processed),
@@ -260,15 +266,13 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
     std::printf("%s offline re-run: %zu vs %zu scans, max position difference %.3g m, "
                 "max rotation difference %.3g deg\n",
                 name.c_str(), again.size(), live.size(), max_dp, max_dq_deg);
+    // The re-run left out the scans the live run dropped: the same scans, the
+    // same states.
     const LiveStats& st = drones[i]->stats();
-    if (st.scans_dropped_queue + st.scans_dropped_backlog == 0) {
-      EXPECT_EQ(again.size(), live.size());
-      EXPECT_LE(max_dp, 1e-9);
-      EXPECT_LE(max_dq_deg, 1e-7);
-    } else {
-      // The re-run processes the scans the live run dropped: close, not equal.
-      EXPECT_LE(max_dp, 0.5);
-    }
+    EXPECT_EQ(run->drone(i).skipped_scans(), st.scans_dropped_queue + st.scans_dropped_backlog);
+    EXPECT_EQ(again.size(), live.size());
+    EXPECT_LE(max_dp, 1e-9);
+    EXPECT_LE(max_dq_deg, 1e-7);
   }
 }
 
@@ -292,7 +296,7 @@ TEST_F(LiveDropTest, FallingBehindDropsWholeScansNeverImu) {
               static_cast<long long>(st.scans_processed), static_cast<long long>(st.imu_samples));
   EXPECT_EQ(dropped, st.scans_played);  // always more than 0.05 s behind: every scan dropped
   EXPECT_EQ(st.scans_processed, 0);
-  EXPECT_EQ(sink.dropped, dropped);
+  EXPECT_EQ(static_cast<int64_t>(sink.dropped_stamps_ns.size()), dropped);
   EXPECT_EQ(c.scans, 0);  // no scan reached the estimator
   EXPECT_EQ(c.imu_samples, st.imu_samples);       // no IMU sample is ever dropped
   EXPECT_GT(st.imu_samples, static_cast<int64_t>(150 * kDropTestDurationS));

@@ -58,6 +58,7 @@ class OdometrySink : public sim::DroneSink {
 struct Case {
   int drone;
   double max_rmse_m;
+  double max_nees = 9.0;  // mean position NEES (3 dof); the band's top is 3 x 3
 };
 
 // configs/scenarios/<name>.yaml with its scenario seed (the first `seed: N`)
@@ -116,7 +117,10 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
   sim::Simulator simulator(std::move(scenario.scene), drones, scenario.objects, config);
 
   // uav1: Mid-360 (m/s^2 IMU); uav3: Avia (IMU in g, 2 ms stamp offset).
-  for (const Case c : {Case{0, 0.02}, Case{2, 0.06}}) {
+  // NEES: 0.59 and 0.24 measured (Release, session 18): under-confident on a
+  // flight that is 4 s static and 6 s of take-off. Bounded at 3x the measured
+  // value (a covariance shrunk 3x fails) and at 0.1 (one inflated 3-6x fails).
+  for (const Case c : {Case{0, 0.02, 1.8}, Case{2, 0.06, 0.75}}) {
     const sim::DroneConfig& d = drones[c.drone];
     SCOPED_TRACE(d.name);
     lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
@@ -145,7 +149,8 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
                 consistency.rotation_rmse_deg, consistency.mean_position_nees);
     EXPECT_LT(consistency.position_rmse_m, c.max_rmse_m);
     EXPECT_LT(consistency.rotation_rmse_deg, 1.0);
-    EXPECT_LT(consistency.mean_position_nees, 30.0);
+    EXPECT_LT(consistency.mean_position_nees, c.max_nees);
+    EXPECT_GT(consistency.mean_position_nees, 0.1);
   }
 }
 

@@ -1,6 +1,7 @@
 // SwarmReplay on simulated bags: the same logs and network seed give the
 // same outputs bit for bit; the single-agent ablation fuses nothing but
-// keeps messaging; bad inputs give clear errors. The swarm estimator's own
+// keeps messaging; listed scans are left out (a live run's dropped scans);
+// bad inputs give clear errors. The swarm estimator's own
 // end-to-end test is swarm_end_to_end_test.cc.
 #include "swarmlio/replay/swarm_replay.h"
 
@@ -8,8 +9,12 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
+
+#include "swarmlio/io/bag_reader.h"
+#include "swarmlio/replay/dropped_scans.h"
 
 #include "swarmlio/sim/output_writer.h"
 #include "swarmlio/sim/scenario.h"
@@ -139,6 +144,76 @@ TEST_F(SwarmReplayTest, SingleAgentAblationFusesNothingButKeepsMessaging) {
       ASSERT_TRUE(r.state.p_b_in_G.allFinite());
     }
   }
+}
+
+// The record stamps of the scans in a bag.
+std::vector<int64_t> ScanStamps(const std::string& bag_path) {
+  std::vector<int64_t> stamps;
+  std::unique_ptr<io::BagReader> reader;
+  EXPECT_TRUE(io::BagReader::Open(bag_path, io::BagReaderOptions(), &reader).ok());
+  io::BagRecord record;
+  bool has = true;
+  while (reader && reader->Next(&record, &has).ok() && has) {
+    if (record.scan() != nullptr) stamps.push_back(record.stamp_ns());
+  }
+  return stamps;
+}
+
+// A re-run of a live drone leaves out the scans the live run dropped: the
+// listed scans are never processed, the states before them are unchanged.
+TEST_F(SwarmReplayTest, LeavesOutTheListedScans) {
+  const auto all = Run(ReplayOptions());
+  const std::vector<int64_t> stamps = ScanStamps((*dir_ / "uav2.bag").string());
+  ASSERT_GT(stamps.size(), 50u);
+  ReplayOptions options;
+  // Two scans after the static start, and a stamp of no scan (ignored).
+  options.dropped_scans["uav2"] = {stamps[45], stamps[46], stamps[46] + 1};
+  const auto fewer = Run(options);
+  EXPECT_EQ(fewer->drone(1).skipped_scans(), 2);
+  EXPECT_EQ(fewer->drone(0).skipped_scans(), 0);
+  const std::vector<ScanRecord>& a = all->drone(1).scans();
+  const std::vector<ScanRecord>& b = fewer->drone(1).scans();
+  ASSERT_EQ(b.size() + 2, a.size());
+  size_t same = 0;
+  while (same < b.size() && b[same].stamp_ns == a[same].stamp_ns &&
+         b[same].state.p_b_in_G == a[same].state.p_b_in_G) {
+    ++same;
+  }
+  EXPECT_GT(same, 30u);  // the scans before the gap: identical
+  EXPECT_LT(same, b.size());  // the gap: a scan ends where the dropped ones did not
+  for (const ScanRecord& r : b) {
+    EXPECT_NE(r.stamp_ns, a[same].stamp_ns) << "a dropped scan was processed";
+  }
+
+  ReplayOptions unknown;
+  unknown.dropped_scans["uav9"] = {stamps[45]};
+  std::unique_ptr<SwarmReplay> run;
+  ASSERT_TRUE(SwarmReplay::Create(Manifest(), &run).ok());
+  const Status status = run->Run(unknown);
+  EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(status.message().find("uav9"), std::string::npos) << status.message();
+}
+
+TEST_F(SwarmReplayTest, DroppedScansFileIsReadOrRefusedByLine) {
+  const std::string path = (*dir_ / "uav1_dropped_scans.txt").string();
+  std::ofstream(path) << kDroppedScansHeader << "1000000000 queue\n\n2500000000 backlog\n";
+  std::vector<int64_t> stamps;
+  ASSERT_TRUE(ReadDroppedScans(path, &stamps).ok());
+  EXPECT_EQ(stamps, (std::vector<int64_t>{1000000000, 2500000000}));
+
+  for (const char* bad : {"12 queue\n1.5 queue\n", "12 queue\n13 late\n", "12 queue\n13\n",
+                          "12 queue\n13 queue extra\n"}) {
+    SCOPED_TRACE(bad);
+    std::ofstream(path) << kDroppedScansHeader << bad;
+    std::vector<int64_t> none = {7};
+    const Status status = ReadDroppedScans(path, &none);
+    EXPECT_EQ(status.code(), Status::Code::kDataLoss);
+    EXPECT_NE(status.message().find("uav1_dropped_scans.txt:3:"), std::string::npos)
+        << status.message();
+    EXPECT_EQ(none, std::vector<int64_t>{7});  // untouched
+  }
+  EXPECT_EQ(ReadDroppedScans((*dir_ / "none.txt").string(), &stamps).code(),
+            Status::Code::kIoError);
 }
 
 TEST_F(SwarmReplayTest, BadInputsGiveClearErrors) {

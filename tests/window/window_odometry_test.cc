@@ -204,7 +204,10 @@ TEST(WindowOdometry, WindowOfFiveTracksAShortIndoorFlight) {
                 consistency.mean_position_nees);
     EXPECT_LT(consistency.position_rmse_m, 0.02);
     EXPECT_LT(consistency.rotation_rmse_deg, 1.0);
-    EXPECT_LT(consistency.mean_position_nees, 30.0);
+    // Measured 0.59 (filter) and 0.71 (window), Release, session 18: 3x
+    // over it fails a covariance shrunk 3x, 0.2 one inflated 3x.
+    EXPECT_LT(consistency.mean_position_nees, 2.0);
+    EXPECT_GT(consistency.mean_position_nees, 0.2);
   }
   EXPECT_EQ(window->counters().window_restarts, 0);
 }

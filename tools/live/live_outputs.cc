@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <memory>
 
+#include "swarmlio/replay/dropped_scans.h"
+
 namespace swarmlio::tools {
 namespace {
 
@@ -34,6 +36,8 @@ Status LiveOutputs::Open(const std::string& dir, const std::string& name, bool i
       OpenFile(o->identifications_path_,
                "observer,teammate,stamp_s,since_first_scan_s,method,mean_residual_m\n",
                &o->identifications_));
+  o->dropped_path_ = (base / (name + "_dropped_scans.txt")).string();
+  SWARMLIO_RETURN_IF_ERROR(OpenFile(o->dropped_path_, replay::kDroppedScansHeader, &o->dropped_));
   o->tum_path_ = (base / (name + "_tum.txt")).string();
   o->timing_path_ = (base / (name + "_timing.csv")).string();
   SWARMLIO_RETURN_IF_ERROR(
@@ -104,9 +108,13 @@ void LiveOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& l
 }
 
 void LiveOutputs::OnScanDropped(int64_t scan_stamp_ns, live::ScanDropReason reason) {
-  Check(std::fprintf(timing_, "%.9f,%s,,,,,,,,,,,,\n", StampSeconds(scan_stamp_ns),
-                     reason == live::ScanDropReason::kQueueFull ? "queue" : "backlog") > 0,
+  const char* why = reason == live::ScanDropReason::kQueueFull ? "queue" : "backlog";
+  Check(std::fprintf(timing_, "%.9f,%s,,,,,,,,,,,,\n", StampSeconds(scan_stamp_ns), why) > 0,
         timing_path_);
+  // Flushed at once: a re-run of a crashed process still leaves these out.
+  Check(std::fprintf(dropped_, "%lld %s\n", static_cast<long long>(scan_stamp_ns), why) > 0 &&
+            std::fflush(dropped_) == 0,
+        dropped_path_);
 }
 
 void LiveOutputs::OnImuPose(const live::ImuRatePose& p) {
@@ -123,7 +131,8 @@ Status LiveOutputs::Close() {
   for (auto [file, path] :
        {std::pair{&tum_, &tum_path_}, std::pair{&timing_, &timing_path_},
         std::pair{&imu_, &imu_path_}, std::pair{&extrinsics_, &extrinsics_path_},
-        std::pair{&identifications_, &identifications_path_}}) {
+        std::pair{&identifications_, &identifications_path_},
+        std::pair{&dropped_, &dropped_path_}}) {
     if (*file == nullptr) continue;
     Check(std::fclose(*file) == 0, *path);
     *file = nullptr;

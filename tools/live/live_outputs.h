@@ -7,6 +7,8 @@
 //   <name>_extrinsics.csv  per scan and teammate in the state: T_Gi_Gj, its covariance
 //                        diagonal, observations fused (the replay's columns)
 //   <name>_identifications.csv  every identification (the replay's columns)
+//   <name>_dropped_scans.txt  the record stamps of the dropped scans [ns], which the
+//                        offline re-run leaves out (replay/dropped_scans.h)
 #pragma once
 
 #include <cstdio>
@@ -46,12 +48,14 @@ class LiveOutputs : public live::LiveSink {
   std::string name_;
   std::vector<std::string> drone_names_;
   double first_scan_s_ = -1.0;
-  std::string tum_path_, timing_path_, imu_path_, extrinsics_path_, identifications_path_;
+  std::string tum_path_, timing_path_, imu_path_, extrinsics_path_, identifications_path_,
+      dropped_path_;
   std::FILE* tum_ = nullptr;
   std::FILE* timing_ = nullptr;
   std::FILE* imu_ = nullptr;
   std::FILE* extrinsics_ = nullptr;
   std::FILE* identifications_ = nullptr;
+  std::FILE* dropped_ = nullptr;
   std::vector<float> latencies_ms_;
   std::string error_;
 };

@@ -31,6 +31,7 @@
 #include "swarmlio/eval/error_statistics.h"
 #include "swarmlio/net/swarm_key_file.h"
 #include "swarmlio/replay/consistency.h"
+#include "swarmlio/replay/dropped_scans.h"
 #include "swarmlio/replay/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
 
@@ -60,7 +61,8 @@ DEFINE_string(window_reassociate, "",
 DEFINE_string(received_packets, "",
               "offline re-run of live drones (docs/online.md): name=<name>_received.bin,... "
               "those drones receive exactly the recorded datagrams at their recorded arrival "
-              "times instead of the simulated network (needs --key_file)");
+              "times instead of the simulated network (needs --key_file); the scans listed in "
+              "<name>_dropped_scans.txt next to it (the ones the live run dropped) are left out");
 DEFINE_string(key_file, "",
               "the swarm key (64 hex digits) the recorded datagrams were authenticated with; "
               "default: the simulation key of the network seed");
@@ -80,6 +82,26 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
+// The live process writes <name>_dropped_scans.txt next to
+// <name>_received.bin; a recording without it re-runs every scan.
+Status ReadDroppedScansNextTo(const std::string& name, const std::string& received_path,
+                              replay::ReplayOptions* options) {
+  const std::string suffix = "_received.bin";
+  if (received_path.size() < suffix.size() ||
+      received_path.compare(received_path.size() - suffix.size(), suffix.size(), suffix) != 0) {
+    std::fprintf(stderr, "note: %s: not a <name>_received.bin path, every scan is re-run\n",
+                 received_path.c_str());
+    return Status::Ok();
+  }
+  const std::string path =
+      received_path.substr(0, received_path.size() - suffix.size()) + "_dropped_scans.txt";
+  if (!std::filesystem::exists(path)) {
+    std::fprintf(stderr, "note: no %s: every scan of %s is re-run\n", path.c_str(), name.c_str());
+    return Status::Ok();
+  }
+  return replay::ReadDroppedScans(path, &options->dropped_scans[name]);
+}
+
 // --received_packets and --key_file into the replay options.
 Status ApplyReceivedPacketFlags(replay::ReplayOptions* options) {
   for (const std::string& item : Split(FLAGS_received_packets)) {
@@ -88,7 +110,9 @@ Status ApplyReceivedPacketFlags(replay::ReplayOptions* options) {
       return Status::InvalidArgument("--received_packets: '" + item +
                                      "' is not name=path (e.g. uav1=out/uav1_received.bin)");
     }
-    options->received_packets[item.substr(0, eq)] = item.substr(eq + 1);
+    const std::string name = item.substr(0, eq), path = item.substr(eq + 1);
+    options->received_packets[name] = path;
+    SWARMLIO_RETURN_IF_ERROR(ReadDroppedScansNextTo(name, path, options));
   }
   if (!FLAGS_key_file.empty()) {
     net::SwarmKey key;

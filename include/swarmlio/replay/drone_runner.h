@@ -89,6 +89,12 @@ class DroneRunner {
   void TakeMessages(std::vector<net::SwarmMessage>* messages);
   /// Ablation switch: fuse mutual observations (true) or not.
   void SetFusion(bool fuse);
+  /// Re-run of a live drone: the scans with these stamps (the ones the live
+  /// run dropped) are left out, so the re-run processes exactly the scans the
+  /// live run processed. IMU samples are never left out.
+  void SkipScans(std::vector<int64_t> scan_stamps_ns);
+  /// Scans left out by SkipScans so far.
+  int64_t skipped_scans() const { return skipped_scans_; }
   /// Identifications so far.
   const std::vector<swarm::IdentificationEvent>& identifications() const {
     return identifications_;
@@ -120,6 +126,8 @@ class DroneRunner {
   bool fuse_ = true;
   int drone_id_ = 0;
   int64_t restart_ns_ = -1;  // pending restart: the log stamp (-1: none)
+  std::vector<int64_t> skip_scan_stamps_ns_;  // sorted
+  int64_t skipped_scans_ = 0;
   std::vector<ScanRecord> scans_;
   std::vector<swarm::DroneOutput> outputs_;  // scratch
   std::vector<swarm::IdentificationEvent> identifications_;

@@ -57,6 +57,11 @@ struct ReplayOptions {
   /// simulated network; what it sends is discarded. A truncated or corrupt
   /// log is re-run up to the damage and Run() returns its DataLoss.
   std::map<std::string, std::string> received_packets;
+  /// Drone name -> record stamps of scans to leave out: for a re-run, the
+  /// scans the live run dropped (`<name>_dropped_scans.txt` of swarmlio_live,
+  /// ReadDroppedScans), so that it processes exactly the scans the live run
+  /// processed and reproduces its trajectory. Stamps without a scan are ignored.
+  std::map<std::string, std::vector<int64_t>> dropped_scans;
   /// Key of the packet codec (the live swarm's key for received_packets);
   /// default: SwarmKey::ForSimulation(network.seed).
   std::optional<net::SwarmKey> key;
@@ -95,6 +100,8 @@ class SwarmReplay {
   std::vector<std::unique_ptr<DroneRunner>> runners_;
   Status SetUpNetwork(const ReplayOptions& options);
   Status OpenRecordedPackets(const ReplayOptions& options);
+  Status SkipDroppedScans(const ReplayOptions& options);
+  int FindDrone(const std::string& name) const;  // -1: none of that name
   Status Broadcast(int drone, int64_t now_ns);
   std::vector<net::SwarmMessage> outbox_;
 
