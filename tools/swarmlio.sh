@@ -67,7 +67,7 @@ SANITIZER_BUILD_TYPE=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWI
 # (SwarmReplayTest.SameSeedGivesIdenticalResultsAndTraffic), the live swarm
 # over UDP with its offline re-run (LiveSwarmTest), and the odometry's short
 # indoor flight (OdometryEndToEnd.TracksAShortIndoorFlight).
-SANITIZER_SKIP='^((InFlightStartTest|WindowSwarmTest|SwarmEndToEndTest|SwarmClockTest)\.[A-Za-z]+|ClockSyncSimulation\.SymmetricJitterNeedsManyExchanges|OdometryEndToEnd\.ConsistentOnTheRealisticSimulatorOnAHeldOutSeed|TeammateEndToEnd\.Uav2IdentifiesBothTeammatesInIndoor3uav|SwarmReplayTest\.SingleAgentAblationFusesNothingButKeepsMessaging)$'
+SANITIZER_SKIP='^((InFlightStartTest|WindowSwarmTest|SwarmEndToEndTest|SwarmClockTest)\.[A-Za-z]+|ClockSyncSimulation\.SymmetricJitterNeedsManyExchanges|OdometryEndToEnd\.ConsistentOnTheRealisticSimulatorOnAHeldOutSeed|TeammateEndToEnd\.Uav2IdentifiesBothTeammatesInIndoor3uavOnEstimatedPoses|SwarmReplayTest\.SingleAgentAblationFusesNothingButKeepsMessaging)$'
 
 install_packages() {
   local missing=()

@@ -4,7 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
+
+#include "swarmlio/lio/odometry.h"
+#include "swarmlio/replay/manifest.h"
 
 namespace swarmlio::teammate::harness {
 namespace {
@@ -42,15 +46,25 @@ std::vector<Delivery> MakeBroadcasts(const sim::Simulator& sim, int observer,
       const double t = d.lidar.start_time_s + k * period;
       if (t > sim.config().duration_s + 1e-9) break;
       if (uniform(rng) < options.drop_probability) continue;
-      const sim::KinematicState s = d.trajectory.StateAt(t);
       Delivery delivery;
       delivery.arrival_true_s = t + options.latency_s;
       TeammateOdometry& m = delivery.odometry;
       m.drone_id = j;
       m.stamp_s = StampSeconds(sim.StampNs(observer, t));
-      m.p_bj_in_Gj = T_Gj_W * s.p_b_in_W;
-      m.q_Gj_bj = Eigen::Quaterniond(T_Gj_W.linear() * s.R_W_b).normalized();
-      m.v_bj_in_Gj = T_Gj_W.linear() * s.v_b_in_W;
+      if (options.ego_estimates != nullptr) {
+        EgoEstimate s;
+        if (!(*options.ego_estimates)[static_cast<size_t>(j)].StateAt(sim.StampNs(j, t), &s)) {
+          continue;  // no estimate yet: nothing to broadcast
+        }
+        m.p_bj_in_Gj = s.p_b_in_G;
+        m.q_Gj_bj = s.q_G_b;
+        m.v_bj_in_Gj = s.v_b_in_G;
+      } else {
+        const sim::KinematicState s = d.trajectory.StateAt(t);
+        m.p_bj_in_Gj = T_Gj_W * s.p_b_in_W;
+        m.q_Gj_bj = Eigen::Quaterniond(T_Gj_W.linear() * s.R_W_b).normalized();
+        m.v_bj_in_Gj = T_Gj_W.linear() * s.v_b_in_W;
+      }
       out.push_back(delivery);
     }
   }
@@ -60,6 +74,9 @@ std::vector<Delivery> MakeBroadcasts(const sim::Simulator& sim, int observer,
   return out;
 }
 
+// The observer's scans as detector inputs. Ego poses are taken in a frame F:
+// W for the true trajectory (T_Gi_F_ = T_Gi_W), G_i itself for the estimate
+// (T_Gi_F_ = identity), so the true-pose arithmetic is the original one.
 class HarnessSink : public sim::DroneSink {
  public:
   HarnessSink(const sim::Simulator& sim, int observer, const HarnessOptions& options,
@@ -70,32 +87,51 @@ class HarnessSink : public sim::DroneSink {
         callback_(callback),
         deliveries_(MakeBroadcasts(sim, observer, options)) {
     const sim::DroneConfig& d = sim.drones()[static_cast<size_t>(observer)];
-    R_imu_lidar_ = d.lidar.sensor.QuaternionImuLidar().toRotationMatrix();
-    p_lidar_in_imu_ = d.lidar.sensor.p_lidar_in_imu_m;
-    T_Gi_W_ = ToIsometry(sim.T_W_G(observer)).inverse();
+    if (options.ego_estimates != nullptr) {
+      estimate_ = &(*options.ego_estimates)[static_cast<size_t>(observer)];
+      // The extrinsic the odometry was given, as the estimated poses are its.
+      R_imu_lidar_ = estimate_->calibration.R_imu_lidar;
+      p_lidar_in_imu_ = estimate_->calibration.p_lidar_in_imu_m;
+      T_Gi_F_ = Eigen::Isometry3d::Identity();
+    } else {
+      // The true extrinsic (the sensor as simulated), with the true poses.
+      R_imu_lidar_ = d.lidar.sensor.QuaternionImuLidar().toRotationMatrix();
+      p_lidar_in_imu_ = d.lidar.sensor.p_lidar_in_imu_m;
+      T_Gi_F_ = ToIsometry(sim.T_W_G(observer)).inverse();
+    }
   }
 
   Status OnImu(const ImuSample&) override { return Status::Ok(); }
   Status OnGroundTruth(const PoseStamped&) override { return Status::Ok(); }
 
   Status OnScan(const LidarScan& scan, int64_t record_time_ns) override {
-    const sim::Trajectory& trajectory = sim_.drones()[static_cast<size_t>(observer_)].trajectory;
     const double t_start = TrueTime(sim_, observer_, scan.stamp_ns);
     const double t_end = TrueTime(sim_, observer_, record_time_ns);
-    const Eigen::Isometry3d T_W_bend = ToIsometry(trajectory.PoseAt(t_end));
-    const Eigen::Isometry3d T_bend_W = T_W_bend.inverse();
+    Eigen::Isometry3d T_F_bend;
+    if (!PoseAt(t_end, record_time_ns, &T_F_bend)) {
+      ++scans_without_pose_;
+      return Status::Ok();
+    }
+    const Eigen::Isometry3d T_bend_F = T_F_bend.inverse();
     // Body pose at 1 ms steps over the frame, relative to the body at its end.
     const double dt = options_.pose_sample_dt_s;
     const int num_samples = static_cast<int>(std::ceil((t_end - t_start) / dt)) + 1;
     T_bend_bk_.resize(static_cast<size_t>(num_samples));
     for (int k = 0; k < num_samples; ++k) {
-      T_bend_bk_[static_cast<size_t>(k)] = T_bend_W * ToIsometry(trajectory.PoseAt(t_start + k * dt));
+      const int64_t stamp_ns =
+          std::min<int64_t>(scan.stamp_ns + std::llround(k * dt * 1e9), record_time_ns);
+      Eigen::Isometry3d T_F_bk;
+      if (!PoseAt(t_start + k * dt, stamp_ns, &T_F_bk)) {
+        ++scans_without_pose_;  // the frame began before the first estimate
+        return Status::Ok();
+      }
+      T_bend_bk_[static_cast<size_t>(k)] = T_bend_F * T_F_bk;
     }
     PreparedScan& out = prepared_;
     out.observer = observer_;
     out.stamp_s = StampSeconds(record_time_ns);
     out.t_true_s = t_end;
-    out.T_Gi_bi = T_Gi_W_ * T_W_bend;
+    out.T_Gi_bi = T_Gi_F_ * T_F_bend;
     out.points.resize(scan.points.size());
     for (size_t i = 0; i < scan.points.size(); ++i) {
       const LidarPoint& p = scan.points[i];
@@ -116,18 +152,79 @@ class HarnessSink : public sim::DroneSink {
     return callback_(out);
   }
 
+  int scans_without_pose() const { return scans_without_pose_; }
+
  private:
+  // The observer's body pose in F at true time t (its clock: stamp_ns).
+  bool PoseAt(double t, int64_t stamp_ns, Eigen::Isometry3d* T_F_b) const {
+    if (estimate_ == nullptr) {
+      *T_F_b = ToIsometry(sim_.drones()[static_cast<size_t>(observer_)].trajectory.PoseAt(t));
+      return true;
+    }
+    EgoEstimate s;
+    if (!estimate_->StateAt(stamp_ns, &s)) return false;
+    *T_F_b = Eigen::Isometry3d::Identity();
+    T_F_b->linear() = s.q_G_b.toRotationMatrix();
+    T_F_b->translation() = s.p_b_in_G;
+    return true;
+  }
+
   const sim::Simulator& sim_;
   int observer_;
   HarnessOptions options_;
   const ScanCallback& callback_;
   std::vector<Delivery> deliveries_;
   size_t next_delivery_ = 0;
+  const EstimatedTrajectory* estimate_ = nullptr;  // nullptr: true poses
   Eigen::Matrix3d R_imu_lidar_;
   Eigen::Vector3d p_lidar_in_imu_;
-  Eigen::Isometry3d T_Gi_W_;
+  Eigen::Isometry3d T_Gi_F_;
   std::vector<Eigen::Isometry3d> T_bend_bk_;
   PreparedScan prepared_;
+  int scans_without_pose_ = 0;
+};
+
+// Feeds one drone's simulated IMU and scans to its odometry and keeps the
+// output state of every scan.
+class OdometrySink : public sim::DroneSink {
+ public:
+  OdometrySink(lio::Odometry* odometry, std::vector<EgoEstimate>* states)
+      : odometry_(odometry), states_(states) {}
+
+  Status OnImu(const ImuSample& imu) override {
+    // Data problems are counted by the odometry; only real errors fail the run.
+    Status status = odometry_->AddImu(imu);
+    if (status.ok()) status = Collect(/*flush=*/false);
+    return status.code() == Status::Code::kInvalidArgument ? Status::Ok() : status;
+  }
+  Status OnScan(const LidarScan& scan, int64_t) override {
+    Status status = odometry_->AddScan(scan);
+    const Status processed = Collect(/*flush=*/false);
+    if (status.ok()) status = processed;
+    return status.code() == Status::Code::kInvalidArgument ? Status::Ok() : status;
+  }
+  Status OnGroundTruth(const PoseStamped&) override { return Status::Ok(); }
+
+  // The scans ready (every queued one with `flush`, at the end of the run).
+  Status Collect(bool flush) {
+    outputs_.clear();
+    const Status status = odometry_->ProcessReadyScans(flush, &outputs_);
+    for (const lio::ScanOutput& o : outputs_) {
+      if (!states_->empty() && o.stamp_ns <= states_->back().stamp_ns) continue;
+      EgoEstimate s;
+      s.stamp_ns = o.stamp_ns;
+      s.q_G_b = o.state.q_G_b.normalized();
+      s.p_b_in_G = o.state.p_b_in_G;
+      s.v_b_in_G = o.state.v_b_in_G;
+      states_->push_back(s);
+    }
+    return status;
+  }
+
+ private:
+  lio::Odometry* odometry_;
+  std::vector<EgoEstimate>* states_;
+  std::vector<lio::ScanOutput> outputs_;
 };
 
 double RotationAngleDeg(const Eigen::Matrix3d& R) {
@@ -136,11 +233,93 @@ double RotationAngleDeg(const Eigen::Matrix3d& R) {
 
 }  // namespace
 
+bool EstimatedTrajectory::StateAt(int64_t stamp_ns, EgoEstimate* state) const {
+  if (states.empty() || stamp_ns < states.front().stamp_ns ||
+      stamp_ns > states.back().stamp_ns + kMaxExtrapolationNs) {
+    return false;
+  }
+  const auto after = std::lower_bound(
+      states.begin(), states.end(), stamp_ns,
+      [](const EgoEstimate& s, int64_t stamp) { return s.stamp_ns < stamp; });
+  if (after == states.end()) {
+    *state = states.back();
+    state->p_b_in_G += StampSeconds(stamp_ns - state->stamp_ns) * state->v_b_in_G;
+  } else if (after->stamp_ns == stamp_ns) {
+    *state = *after;
+  } else {
+    const EgoEstimate& a = *(after - 1);
+    const EgoEstimate& b = *after;
+    const double w = static_cast<double>(stamp_ns - a.stamp_ns) /
+                     static_cast<double>(b.stamp_ns - a.stamp_ns);
+    state->p_b_in_G = (1.0 - w) * a.p_b_in_G + w * b.p_b_in_G;
+    state->v_b_in_G = (1.0 - w) * a.v_b_in_G + w * b.v_b_in_G;
+    state->q_G_b = a.q_G_b.slerp(w, b.q_G_b);
+  }
+  state->stamp_ns = stamp_ns;
+  return true;
+}
+
+Status EstimateEgoTrajectories(const sim::Simulator& sim,
+                               std::vector<EstimatedTrajectory>* trajectories) {
+  const size_t n = sim.drones().size();
+  trajectories->assign(n, EstimatedTrajectory());
+  std::vector<std::unique_ptr<lio::Odometry>> odometries(n);
+  std::vector<std::unique_ptr<OdometrySink>> sinks(n);
+  std::vector<sim::DroneSink*> sink_pointers(n);
+  for (size_t j = 0; j < n; ++j) {
+    const sim::DroneConfig& d = sim.drones()[j];
+    EstimatedTrajectory& out = (*trajectories)[j];
+    // The calibration handed to the estimator (with the scenario's error), as
+    // a real drone's swarm.yaml would be: not the truth the simulator uses.
+    out.calibration = sim::GivenCalibration(d);
+    lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    options.imu_time_offset_s = out.calibration.imu_time_offset_s;
+    LidarOptions lidar = d.lidar.sensor;
+    lidar.R_imu_lidar = out.calibration.R_imu_lidar;
+    lidar.p_lidar_in_imu_m = out.calibration.p_lidar_in_imu_m;
+    SWARMLIO_RETURN_IF_ERROR(lio::Odometry::Create(options, lidar, &odometries[j]));
+    sinks[j] = std::make_unique<OdometrySink>(odometries[j].get(), &out.states);
+    sink_pointers[j] = sinks[j].get();
+  }
+  // The drones in parallel (SimulationConfig::num_threads), each with its
+  // own odometry: the result does not depend on the scheduling.
+  SWARMLIO_RETURN_IF_ERROR(sim.Run(sink_pointers, nullptr));
+  for (size_t j = 0; j < n; ++j) {
+    const Status flushed = sinks[j]->Collect(/*flush=*/true);
+    if (!flushed.ok() && flushed.code() != Status::Code::kInvalidArgument) {
+      return flushed.WithContext("drone " + sim.drones()[j].name);
+    }
+  }
+  return Status::Ok();
+}
+
+void EstimateErrors(const sim::Simulator& sim, int drone, const EstimatedTrajectory& estimate,
+                    double* max_position_error_m, double* max_rotation_error_deg) {
+  const Eigen::Isometry3d T_G_W = ToIsometry(sim.T_W_G(drone)).inverse();
+  *max_position_error_m = 0.0;
+  *max_rotation_error_deg = 0.0;
+  for (const EgoEstimate& s : estimate.states) {
+    const double t = TrueTime(sim, drone, s.stamp_ns);
+    const Eigen::Isometry3d T_G_b =
+        T_G_W * ToIsometry(sim.drones()[static_cast<size_t>(drone)].trajectory.PoseAt(t));
+    *max_position_error_m =
+        std::max(*max_position_error_m, (s.p_b_in_G - T_G_b.translation()).norm());
+    *max_rotation_error_deg =
+        std::max(*max_rotation_error_deg,
+                 RotationAngleDeg(T_G_b.linear().transpose() * s.q_G_b.toRotationMatrix()));
+  }
+}
+
 Status SimulateObserver(const sim::Simulator& sim, int observer, const HarnessOptions& options,
-                        const ScanCallback& callback) {
+                        const ScanCallback& callback, int* scans_without_pose) {
+  if (options.ego_estimates != nullptr && options.ego_estimates->size() != sim.drones().size()) {
+    return Status::InvalidArgument("SimulateObserver: need one ego estimate per drone");
+  }
   HarnessSink sink(sim, observer, options, callback);
   sim::DroneStats stats;
-  return sim.RunDrone(observer, &sink, &stats);
+  const Status status = sim.RunDrone(observer, &sink, &stats);
+  if (scans_without_pose != nullptr) *scans_without_pose = sink.scans_without_pose();
+  return status;
 }
 
 Eigen::Isometry3d TrueGlobalExtrinsic(const sim::Simulator& sim, int i, int j) {
@@ -271,7 +450,7 @@ Status EvaluateObserver(const sim::Simulator& sim, int observer,
     if (on_result) on_result(scan, result);
     return Status::Ok();
   };
-  return SimulateObserver(sim, observer, options, callback);
+  return SimulateObserver(sim, observer, options, callback, &report->scans_without_pose);
 }
 
 }  // namespace swarmlio::teammate::harness

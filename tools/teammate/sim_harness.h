@@ -1,18 +1,25 @@
 // Simulation harness for the teammate detector (docs/teammate.md,
-// "Acceptance"): turns one simulated drone's scans into detector inputs
-// using TRUE poses, makes the teammates' broadcasts from their true
-// trajectories, and measures the detector's outputs against the truth.
+// "Acceptance"): turns one simulated drone's scans into detector inputs,
+// makes the teammates' broadcasts, and measures the detector's outputs
+// against the truth.
 //
-// Input conventions (the issue prescribes true ego poses):
+// Ego poses (the observer's and the teammates' broadcast states) come from
+// the TRUE trajectories by default (the issue prescribes true ego poses), or
+// from each drone's lio::Odometry estimate (EstimateEgoTrajectories) when
+// HarnessOptions::ego_estimates is set. Input conventions:
 //  - Every point is moved from the LiDAR frame to the body frame at the scan
-//    END with the true trajectory at the point's own time (1 ms pose
-//    samples), so the scan is motion-compensated exactly; the scan stamp is
-//    the end of the frame (record time) and T_Gi_bi is the true pose then.
-//  - Teammate j broadcasts its true state in G_j at each of its scan ends
+//    END with the ego pose at the point's own time (1 ms pose samples), so
+//    the scan is motion-compensated (exactly with true poses); the scan stamp
+//    is the end of the frame (record time) and T_Gi_bi is the ego pose then.
+//    True poses use the true LiDAR-IMU extrinsic, estimated poses the one the
+//    odometry was given (with the scenario's calibration error).
+//  - Teammate j broadcasts its ego state in G_j at each of its scan ends
 //    (its LiDAR rate), a seeded fraction of the messages is lost, and the rest
 //    arrive `latency_s` later. Stamps are converted into the observer's clock
 //    with the simulator's StampNs (a perfectly synchronised clock; the real
 //    system corrects the offset with its NTP-style exchange).
+//  - Without an ego pose (estimates: before the odometry's first output) a
+//    scan is skipped and counted, a broadcast is not sent.
 #pragma once
 
 #include <Eigen/Core>
@@ -28,11 +35,54 @@
 
 namespace swarmlio::teammate::harness {
 
+/// One state of a drone's estimated ego trajectory, in its own global frame.
+struct EgoEstimate {
+  int64_t stamp_ns = 0;  // the drone's clock
+  Eigen::Quaterniond q_G_b = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d p_b_in_G = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_b_in_G = Eigen::Vector3d::Zero();
+};
+
+/// A drone's ego trajectory as its lio::Odometry estimated it: the output
+/// state of every scan (at the scan end, the drone's clock) in the drone's
+/// G (the odometry's global frame is the simulator's G_j = T_W_G(j): the IMU
+/// frame at t = 0, where the drone stands still).
+struct EstimatedTrajectory {
+  /// The calibration the odometry was given (sim::GivenCalibration: the
+  /// truth with the scenario's calibration error); the harness moves the
+  /// points into the body with the same extrinsic.
+  sim::SensorCalibration calibration;
+  std::vector<EgoEstimate> states;  // strictly increasing stamps
+
+  /// The state at `stamp_ns`: between two outputs position and velocity are
+  /// interpolated linearly and the attitude by slerp; up to
+  /// kMaxExtrapolationNs after the last output, extrapolated with its
+  /// velocity (the odometry stamps a scan at its last point, ~5 us before
+  /// the frame's end on indoor_3uav). False outside that (before the first
+  /// output).
+  bool StateAt(int64_t stamp_ns, EgoEstimate* state) const;
+
+  static constexpr int64_t kMaxExtrapolationNs = 1000000;  // 1 ms
+};
+
+/// Runs lio::Odometry (replay::DefaultOdometryOptions, the given
+/// calibration) over every drone's simulated data (Simulator::Run, drones in
+/// parallel) and keeps its per-scan outputs; (*trajectories)[j] is drone j's.
+Status EstimateEgoTrajectories(const sim::Simulator& sim,
+                               std::vector<EstimatedTrajectory>* trajectories);
+/// The largest position [m] and attitude [deg] errors of drone `drone`'s
+/// estimated states against its true trajectory in G_j.
+void EstimateErrors(const sim::Simulator& sim, int drone, const EstimatedTrajectory& estimate,
+                    double* max_position_error_m, double* max_rotation_error_deg);
+
 struct HarnessOptions {
   double drop_probability = 0.1;  // fraction of lost broadcast messages
   double latency_s = 0.02;        // delivery delay of a broadcast [s]
   uint64_t seed = 7;              // message-loss seed
-  double pose_sample_dt_s = 0.001;  // true-pose sampling for motion compensation [s]
+  double pose_sample_dt_s = 0.001;  // ego-pose sampling for motion compensation [s]
+  /// The ego poses of every drone (observer and teammates), by drone index;
+  /// nullptr: the true trajectories. Not owned; must outlive the run.
+  const std::vector<EstimatedTrajectory>* ego_estimates = nullptr;
 };
 
 /// One scan ready for TeammateDetector::ProcessScan.
@@ -40,7 +90,7 @@ struct PreparedScan {
   int observer = 0;
   double stamp_s = 0.0;   // observer clock, scan end
   double t_true_s = 0.0;  // true time of the scan end
-  Eigen::Isometry3d T_Gi_bi = Eigen::Isometry3d::Identity();  // true pose at the scan end
+  Eigen::Isometry3d T_Gi_bi = Eigen::Isometry3d::Identity();  // ego pose at the scan end
   std::vector<ScanPoint> points;
   std::vector<TeammateOdometry> odometry;  // broadcasts delivered since the previous scan
 };
@@ -48,9 +98,10 @@ struct PreparedScan {
 using ScanCallback = std::function<Status(const PreparedScan&)>;
 
 /// Simulates drone `observer` (Simulator::RunDrone) and calls `callback` for
-/// every scan in time order.
+/// every scan with an ego pose in time order; the others are counted in
+/// `scans_without_pose` (optional).
 Status SimulateObserver(const sim::Simulator& sim, int observer, const HarnessOptions& options,
-                        const ScanCallback& callback);
+                        const ScanCallback& callback, int* scans_without_pose = nullptr);
 
 /// True T_Gi_Gj = T_W_Gi^-1 T_W_Gj.
 Eigen::Isometry3d TrueGlobalExtrinsic(const sim::Simulator& sim, int i, int j);
@@ -98,7 +149,8 @@ struct ObservationRecord {
 
 struct ObserverReport {
   int observer = 0;
-  int scans = 0;
+  int scans = 0;               // scans given to the detector
+  int scans_without_pose = 0;  // skipped: no ego pose (before the estimate's first output)
   int64_t points = 0;
   std::vector<IdentificationRecord> identifications;
   std::vector<ObservationRecord> observations;
