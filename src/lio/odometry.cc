@@ -19,7 +19,6 @@
 namespace swarmlio::lio {
 namespace {
 
-using internal::PendingScan;
 
 using Clock = std::chrono::steady_clock;
 
@@ -87,13 +86,11 @@ Status Odometry::AddImu(const ImuSample& raw) {
     return Status::InvalidArgument("IMU sample at " + std::to_string(raw.stamp_ns) +
                                    " ns has non-finite values; dropped");
   }
-  if (impl_->have_imu && sample.stamp_ns <= impl_->last_imu_stamp_ns) {
+  const Status in_order = impl_->input.AddImuStamp(sample.stamp_ns, raw.stamp_ns);
+  if (!in_order.ok()) {
     ++counters_.imu_out_of_order;
-    return Status::InvalidArgument("IMU sample at " + std::to_string(raw.stamp_ns) +
-                                   " ns is not after the previous one; dropped");
+    return in_order;
   }
-  impl_->have_imu = true;
-  impl_->last_imu_stamp_ns = sample.stamp_ns;
   if (!impl_->initialized) {
     SWARMLIO_RETURN_IF_ERROR(impl_->initializer->AddSample(sample));
     if (!impl_->initializer->WindowFull()) {
@@ -150,25 +147,14 @@ Status Odometry::AddScan(const LidarScan& scan) {
     }
     return Status::Ok();  // expected during the static start: not an error
   }
-  const int64_t previous_end_ns = impl_->scan_queue.empty() ? impl_->last_scan_end_ns
-                                                            : impl_->scan_queue.back().end_ns;
-  if ((impl_->have_scan || !impl_->scan_queue.empty()) && end_ns <= previous_end_ns) {
+  const Status queued = impl_->input.AddScan({scan, end_ns});
+  if (queued.code() == Status::Code::kInvalidArgument) {
     ++counters_.scans_out_of_order;
-    return Status::InvalidArgument("scan at " + std::to_string(scan.stamp_ns) +
-                                   " ns does not end after the previous scan; dropped");
+    return queued;
   }
-  impl_->scan_queue.push_back({scan, end_ns});
   if (impl_->probe.active) impl_->probe.scans.push_back({scan, end_ns});
-  if (static_cast<int>(impl_->scan_queue.size()) > options_.max_queued_scans) {
-    ++counters_.scans_dropped_queue;
-    const Status status = Status::OutOfRange(
-        "no IMU data for " + std::to_string(options_.max_queued_scans) +
-        " scans: dropped the scan at " + std::to_string(impl_->scan_queue.front().scan.stamp_ns) +
-        " ns");
-    impl_->scan_queue.pop_front();
-    return status;
-  }
-  return Status::Ok();
+  if (queued.code() == Status::Code::kOutOfRange) ++counters_.scans_dropped_queue;
+  return queued;
 }
 
 void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
@@ -267,13 +253,9 @@ Status Odometry::ProcessReadyScans(bool flush, std::vector<ScanOutput>* outputs)
 
 bool Odometry::NextScan(bool flush, ScanContext* scan) {
   Impl& im = *impl_;
-  while (!im.scan_queue.empty()) {
-    const PendingScan& next = im.scan_queue.front();
-    const bool imu_covers = im.have_imu && im.last_imu_stamp_ns >= next.end_ns;
-    if (!imu_covers && !flush) return false;
+  PendingScan pending;
+  while (im.input.PopReady(flush, &pending)) {
     if (im.seed_pending) SeedMapFromStaticStart(im.seed_window_start_ns);
-    PendingScan pending = std::move(im.scan_queue.front());
-    im.scan_queue.pop_front();
     scan->raw = std::move(pending.scan);
     scan->end_ns = pending.end_ns;
     scan->flush = flush;
@@ -435,8 +417,7 @@ Status Odometry::Commit(ScanContext* scan, ScanOutput* output) {
   out.state = scan->x.ego;
   out.covariance = scan->P.topLeftCorner<ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>();
   out.timings.total_s = SecondsSince(scan->started);
-  im.last_scan_end_ns = scan->end_ns;
-  im.have_scan = true;
+  im.input.MarkProcessed(scan->end_ns);
   ++counters_.scans_processed;
   *output = std::move(out);
   return scan->status;

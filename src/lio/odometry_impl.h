@@ -11,6 +11,7 @@
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/in_flight_alignment.h"
+#include "swarmlio/lio/input_synchronizer.h"
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/odometry.h"
 #include "swarmlio/lio/preprocess.h"
@@ -19,11 +20,6 @@
 
 namespace swarmlio::lio {
 namespace internal {
-
-struct PendingScan {
-  LidarScan scan;
-  int64_t end_ns = 0;
-};
 
 // An in-flight initialization in progress (docs/imu.md section 1b): the data
 // since the start t0 are kept, and each pass runs the odometry over them
@@ -52,8 +48,8 @@ struct Odometry::Impl {
   EsikfUpdate update;
   std::unique_ptr<internal::WindowSmoother> window;  // estimator: window
   std::deque<ImuSample> imu_queue;                   // after initialization, not yet propagated
-  std::deque<internal::PendingScan> scan_queue;
-  std::deque<internal::PendingScan> static_start_scans;  // before initialization (map seeding)
+  InputSynchronizer input;  // scans waiting for the IMU, the IMU stamps' order
+  std::deque<PendingScan> static_start_scans;  // before initialization (map seeding)
   // Static start: initialized, the map not seeded yet. The seed waits for the
   // first scan to process, so that a scan of the static window that arrives
   // after the IMU sample completing the initialization (a live input
@@ -62,10 +58,6 @@ struct Odometry::Impl {
   bool seed_pending = false;
   int64_t seed_window_start_ns = 0;
   internal::InFlightProbe probe;
-  int64_t last_imu_stamp_ns = 0;
-  bool have_imu = false;
-  int64_t last_scan_end_ns = 0;
-  bool have_scan = false;
   bool previous_degenerate = false;  // the last updated scan's flag (front end)
   bool map_was_empty = false;        // the filter's map before this scan's update
   ScanContext probe_scan;            // scratch of ProcessReadyScans
@@ -74,7 +66,10 @@ struct Odometry::Impl {
   std::vector<Eigen::Vector3d> undistorted;
 
   Impl(const OdometryOptions& options)
-      : map(options.map), associator(&map, options.association), update(options.update) {}
+      : map(options.map),
+        associator(&map, options.association),
+        update(options.update),
+        input(options.max_queued_scans) {}
 };
 
 }  // namespace swarmlio::lio

@@ -102,10 +102,9 @@ void Odometry::FinishInFlightPass() {
     probe = internal::InFlightProbe();
     im.initialized = false;
     im.imu_queue.clear();
-    im.scan_queue.clear();
+    im.input.ClearScans();
     im.map = LocalMap(options_.map);
     im.initializer->Reset();
-    im.have_scan = false;
     im.previous_degenerate = false;
     init_error_ = status.message();
     return;
@@ -132,7 +131,7 @@ void Odometry::FinishInFlightPass() {
   // the counters (its input counters stay).
   counters_ = ProbeCountersWithInput(probe.counters, counters_);
   im.initialization = next;
-  im.initialization.started_ns = im.last_imu_stamp_ns;  // the newest input
+  im.initialization.started_ns = im.input.newest_imu_ns();  // the newest input
   probe = internal::InFlightProbe();
   init_error_.clear();
 }
@@ -147,9 +146,7 @@ Status Odometry::RestartFromInFlightStart(const ImuInitialization& start) {
                                                               &im.map, &im.window));
   }
   im.imu_queue.assign(im.probe.imu.begin(), im.probe.imu.end());
-  im.scan_queue.assign(im.probe.scans.begin(), im.probe.scans.end());
-  im.have_scan = false;
-  im.last_scan_end_ns = 0;
+  im.input.ReplayScans(im.probe.scans);
   im.previous_degenerate = false;
   return Status::Ok();
 }
