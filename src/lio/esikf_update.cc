@@ -8,6 +8,8 @@
 #include <array>
 #include <chrono>
 #include <memory>
+#include <optional>
+#include <string>
 #include <utility>
 
 #include "factors/ego_state_manifold.h"
@@ -112,9 +114,12 @@ bool AddTermInformation(const ResidualTerm& term, const std::vector<double*>& po
   std::vector<int> offsets(nb), tangent(nb);
   std::vector<const ceres::Manifold*> manifolds(nb);
   for (size_t b = 0; b < nb; ++b) {
-    const bool ego = term.blocks[b] == kEgoBlock;
-    params[b] = ego ? pointers[0] : pointers[static_cast<size_t>(layout.SlotOf(term.blocks[b])) + 1];
-    offsets[b] = ego ? 0 : layout.TeammateBlock(term.blocks[b]).offset;
+    // The keys resolved when the term entered the problem (AddMeasurementBlocks).
+    const StateKey& key = term.blocks[b];
+    const bool ego = key.is_ego();
+    const int id = key.teammate_id();
+    params[b] = ego ? pointers[0] : pointers[static_cast<size_t>(layout.SlotOf(id)) + 1];
+    offsets[b] = ego ? 0 : layout.TeammateBlock(id).offset;
     manifolds[b] = ego ? &ego_manifold : &teammate_manifold;
     tangent[b] = manifolds[b]->TangentSize();
   }
@@ -215,24 +220,53 @@ struct UpdateProblem {
   ceres::Problem problem;
 };
 
+// The parameter block `key` names among `pointers` (the ego state, then the
+// teammates in `layout`'s slot order). The filter holds one ego state: Ego()
+// and EgoAt(t) for t the stamp of the scan being updated (`stamp_ns`, if
+// known) resolve to it; any other EgoAt, or a teammate absent from the
+// layout, is InvalidArgument naming the key.
+Status ResolveKey(const StateKey& key, const std::vector<double*>& pointers,
+                  const ErrorStateLayout& layout, std::optional<int64_t> stamp_ns,
+                  double** block) {
+  switch (key.kind()) {
+    case StateKey::Kind::kEgo:
+      *block = pointers[0];
+      return Status::Ok();
+    case StateKey::Kind::kEgoAt:
+      if (stamp_ns.has_value() && key.stamp_ns() == *stamp_ns) {
+        *block = pointers[0];
+        return Status::Ok();
+      }
+      return Status::InvalidArgument(
+          "EsikfUpdate: a residual block names " + key.ToString() +
+          "; the filter holds only the state at " +
+          (stamp_ns.has_value() ? std::to_string(*stamp_ns) + " ns" : "the scan being updated"));
+    case StateKey::Kind::kTeammateExtrinsic:
+      break;
+  }
+  if (!layout.HasTeammate(key.teammate_id())) {
+    return Status::InvalidArgument("EsikfUpdate: a residual block names teammate " +
+                                   std::to_string(key.teammate_id()) +
+                                   ", absent from the estimated state");
+  }
+  *block = pointers[static_cast<size_t>(layout.SlotOf(key.teammate_id())) + 1];
+  return Status::Ok();
+}
+
 // Adds one residual block per term of `measurements` to `problem`, on the
 // parameter blocks (`pointers`, in `layout`'s slot order) the term names.
 Status AddMeasurementBlocks(const std::vector<double*>& pointers,
                             const ErrorStateLayout& layout,
+                            std::optional<int64_t> stamp_ns,
                             ceres::Problem* problem,
                             MeasurementBlocks* measurements) {
   std::vector<double*> term_pointers;
   for (const ResidualTerm& term : measurements->terms) {
     term_pointers.clear();
-    for (int block : term.blocks) {
-      if (block == kEgoBlock) {
-        term_pointers.push_back(pointers[0]);
-      } else if (layout.HasTeammate(block)) {
-        term_pointers.push_back(pointers[static_cast<size_t>(layout.SlotOf(block)) + 1]);
-      } else {
-        return Status::InvalidArgument("EsikfUpdate: a residual block names teammate " +
-                                       std::to_string(block) + ", absent from the estimated state");
-      }
+    for (const StateKey& key : term.blocks) {
+      double* block = nullptr;
+      SWARMLIO_RETURN_IF_ERROR(ResolveKey(key, pointers, layout, stamp_ns, &block));
+      term_pointers.push_back(block);
     }
     if (term.cost == nullptr || term.cost->parameter_block_sizes().size() != term_pointers.size()) {
       return Status::InvalidArgument(
@@ -248,6 +282,7 @@ Status AddMeasurementBlocks(const std::vector<double*>& pointers,
 // (timed into *association_time_s) and adds the new blocks to the problem.
 Status Relinearize(const std::vector<MeasurementModel*>& models,
                    const SwarmState& x,
+                   std::optional<int64_t> stamp_ns,
                    UpdateProblem* up,
                    double* association_time_s) {
   ceres::Problem* problem = &up->problem;
@@ -266,7 +301,7 @@ Status Relinearize(const std::vector<MeasurementModel*>& models,
     }
   }
   *association_time_s += SecondsSince(t_assoc);
-  return AddMeasurementBlocks(up->blocks.pointers(), x.layout(), problem, measurements);
+  return AddMeasurementBlocks(up->blocks.pointers(), x.layout(), stamp_ns, problem, measurements);
 }
 
 // Posterior (J^T J)^-1 at the final estimate x (the parameter blocks hold
@@ -456,19 +491,21 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat,
 EsikfUpdateResult EsikfUpdate::Run(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
                                    const std::vector<MeasurementModel*>& models,
                                    const std::vector<int>* estimated_teammates,
-                                   const std::vector<int>* considered_teammates) const {
-  return RunFrom(x_hat, P_hat, x_hat, models, estimated_teammates, considered_teammates);
+                                   const std::vector<int>* considered_teammates,
+                                   std::optional<int64_t> stamp_ns) const {
+  return RunFrom(x_hat, P_hat, x_hat, models, estimated_teammates, considered_teammates, stamp_ns);
 }
 
 EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
                                        const SwarmState& x_start,
                                        const std::vector<MeasurementModel*>& models,
                                        const std::vector<int>* estimated_teammates,
-                                       const std::vector<int>* considered_teammates) const {
+                                       const std::vector<int>* considered_teammates,
+                                       std::optional<int64_t> stamp_ns) const {
   const bool none_considered = considered_teammates == nullptr || considered_teammates->empty();
   if (none_considered && (estimated_teammates == nullptr ||
                           *estimated_teammates == x_hat.layout().teammate_ids())) {
-    return RunAll(x_hat, P_hat, x_start, models);
+    return RunAll(x_hat, P_hat, x_start, models, {}, stamp_ns);
   }
   EsikfUpdateResult result;
   result.state = x_hat;
@@ -489,7 +526,8 @@ EsikfUpdateResult EsikfUpdate::RunFrom(const SwarmState& x_hat, const Eigen::Mat
   const std::vector<int> o_idx = Complement(s_idx, x_hat.Dim());
   const Eigen::MatrixXd P_ss = Gather(P_hat, s_idx, s_idx);
   EsikfUpdateResult sub =
-      RunAll(SubsetState(x_hat, ids), P_ss, SubsetState(x_start, ids), models, considered);
+      RunAll(SubsetState(x_hat, ids), P_ss, SubsetState(x_start, ids), models, considered,
+             stamp_ns);
   CopyRunStatistics(sub, &result);
   if (!sub.status.ok()) return result;
 
@@ -512,7 +550,8 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
                                       const Eigen::MatrixXd& P_hat,
                                       const SwarmState& x_start,
                                       const std::vector<MeasurementModel*>& models,
-                                      const std::vector<int>& held) const {
+                                      const std::vector<int>& held,
+                                      std::optional<int64_t> stamp_ns) const {
   const Clock::time_point t_start = Clock::now();
   EsikfUpdateResult result;
   result.state = x_hat;
@@ -538,7 +577,8 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
 
   const ceres::Solver::Options solver_options = GaussNewtonStepOptions(options_.linear_solver);
   for (int it = 0; it < options_.max_iterations; ++it) {
-    if (Status status = Relinearize(models, x, &up, &result.association_time_s); !status.ok()) {
+    if (Status status = Relinearize(models, x, stamp_ns, &up, &result.association_time_s);
+        !status.ok()) {
       return fail(std::move(status));
     }
     result.num_residual_blocks = static_cast<int>(up.measurements.ids.size());

@@ -49,7 +49,7 @@ Status PlaneMeasurementModel::Linearize(const SwarmState& x, std::vector<Residua
   Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
   factor_.AccumulateNormalEquations(x.ego, &A, &b);
   compressed_.Set(A, b, x.ego.q_G_b, x.ego.p_b_in_G);
-  terms->push_back({&compressed_, {kEgoBlock}});
+  terms->push_back({&compressed_, {StateKey::Ego()}});
   return Status::Ok();
 }
 

@@ -443,7 +443,7 @@ void Odometry::UpdateWithFilter(const UpdateRequest& request, ScanContext* scan)
   const bool subset = request.select_teammates;
   const EsikfUpdateResult result =
       im.update.Run(x, P, models, subset ? &request.estimated_teammates : nullptr,
-                    subset ? &request.considered_teammates : nullptr);
+                    subset ? &request.considered_teammates : nullptr, prop.stamp_ns());
   out->timings.association_s = result.association_time_s;
   out->timings.solve_s = result.solve_time_s;
   out->timings.covariance_s = result.covariance_time_s;

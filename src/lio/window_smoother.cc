@@ -178,6 +178,39 @@ void WindowSmoother::Impl::Leave(WindowScan* scan, std::vector<LeavingScan>* lea
   leaving->push_back(std::move(out));
 }
 
+namespace {
+
+bool Names(const OwnedResidualTerm& term, const StateKey& key) {
+  return std::find(term.blocks.begin(), term.blocks.end(), key) != term.blocks.end();
+}
+
+}  // namespace
+
+Status WindowSmoother::Impl::AdoptTerm(int64_t stamp_ns, const char* model,
+                                       OwnedResidualTerm* term) const {
+  for (StateKey& key : term->blocks) {
+    if (key.kind() == StateKey::Kind::kEgo) key = StateKey::EgoAt(stamp_ns);
+  }
+  if (term->cost == nullptr || term->cost->parameter_block_sizes().size() != term->blocks.size()) {
+    return Status::InvalidArgument(std::string("window: a residual block of ") + model +
+                                   " does not match its state blocks");
+  }
+  for (size_t b = 0; b < term->blocks.size(); ++b) {
+    const StateKey& key = term->blocks[b];
+    if (BlockOf(key) == nullptr) {
+      return Status::InvalidArgument(std::string("window: a residual block of ") + model +
+                                     " names " + key.ToString() +
+                                     ", which the window does not hold (marginalized, "
+                                     "never added, or not a teammate in the state)");
+    }
+    if (term->cost->parameter_block_sizes()[b] != ManifoldOf(key)->AmbientSize()) {
+      return Status::InvalidArgument(std::string("window: a residual block of ") + model +
+                                     " does not match its state blocks");
+    }
+  }
+  return Status::Ok();
+}
+
 Status WindowSmoother::Impl::TakeObservations(WindowStateInput* input, WindowScan* scan) {
   Status status;
   for (MeasurementModel* model : input->models) {
@@ -189,21 +222,13 @@ Status WindowSmoother::Impl::TakeObservations(WindowStateInput* input, WindowSca
       continue;
     }
     for (OwnedResidualTerm& term : terms) {
-      bool valid = term.cost != nullptr &&
-                   term.cost->parameter_block_sizes().size() == term.blocks.size();
-      for (size_t b = 0; valid && b < term.blocks.size(); ++b) {
-        const int id = term.blocks[b];
-        valid = (id == kEgoBlock || Teammate(id) != nullptr) &&
-                term.cost->parameter_block_sizes()[b] == ManifoldOf(id)->AmbientSize();
-      }
-      if (!valid) {
-        status = Status::InvalidArgument(std::string("window: a residual block of ") +
-                                         model->name() + " does not match its state blocks");
+      if (Status adopted = AdoptTerm(scan->stamp_ns, model->name(), &term); !adopted.ok()) {
+        status = std::move(adopted);
         continue;
       }
       // Considered teammates: held at the prediction in this scan's terms.
       for (int id : input->considered_teammates) {
-        const auto at = std::find(term.blocks.begin(), term.blocks.end(), id);
+        const auto at = std::find(term.blocks.begin(), term.blocks.end(), StateKey::Extrinsic(id));
         if (at == term.blocks.end() || !input->x_pred.HasTeammate(id)) continue;
         std::vector<double> value(GlobalExtrinsic::kAmbientSize);
         input->x_pred.teammate(id).ToParameters(value.data());
@@ -248,8 +273,7 @@ Status WindowSmoother::Impl::RemoveTeammate(int id) {
     auto& obs = s->observations;
     obs.erase(std::remove_if(obs.begin(), obs.end(),
                              [id](const OwnedResidualTerm& t) {
-                               return std::find(t.blocks.begin(), t.blocks.end(), id) !=
-                                      t.blocks.end();
+                               return Names(t, StateKey::Extrinsic(id));
                              }),
               obs.end());
   }
@@ -304,6 +328,41 @@ Status WindowSmoother::Impl::SyncTeammates(const SwarmState& x_pred, const Eigen
   return Status::Ok();
 }
 
+Status WindowSmoother::Impl::AddTermsNaming(const WindowScan& s0, std::vector<double*>* kept) {
+  const StateKey leaving = StateKey::EgoAt(s0.stamp_ns);
+  for (const auto& s : scans) {
+    for (const OwnedResidualTerm& term : s->observations) {
+      if (!Names(term, leaving)) continue;
+      MarginalizationResidualBlock block;
+      block.cost_function = term.cost.get();
+      BlocksOf(term, &block.parameter_blocks, &block.manifolds);
+      for (double* b : block.parameter_blocks) {
+        if (b != s0.ego.data() && std::find(kept->begin(), kept->end(), b) == kept->end()) {
+          kept->push_back(b);
+        }
+      }
+      SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(block));
+    }
+  }
+  return Status::Ok();
+}
+
+void WindowSmoother::Impl::DropTermsNaming(WindowScan* s0) {
+  const StateKey leaving = StateKey::EgoAt(s0->stamp_ns);
+  for (size_t i = 1; i < scans.size(); ++i) {
+    auto& obs = scans[i]->observations;
+    obs.erase(std::remove_if(obs.begin(), obs.end(),
+                             [&leaving](const OwnedResidualTerm& t) { return Names(t, leaving); }),
+              obs.end());
+  }
+  // A term of the leaving scan that does not name its state (teammate
+  // blocks only) stays in the window, with the next state.
+  for (OwnedResidualTerm& term : s0->observations) {
+    if (!Names(term, leaving)) scans[1]->observations.push_back(std::move(term));
+  }
+  s0->observations.clear();
+}
+
 Status WindowSmoother::Impl::MarginalizeOldest(std::vector<LeavingScan>* leaving) {
   WindowScan& s0 = *scans[0];
   WindowScan& s1 = *scans[1];
@@ -326,16 +385,9 @@ Status WindowSmoother::Impl::MarginalizeOldest(std::vector<LeavingScan>* leaving
   }
   SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(
       {s1.imu_factor.get(), nullptr, {s0.ego.data(), s1.ego.data()}, {&ego_manifold, &ego_manifold}}));
-  for (const OwnedResidualTerm& term : s0.observations) {
-    MarginalizationResidualBlock block;
-    block.cost_function = term.cost.get();
-    for (int b : term.blocks) {
-      block.parameter_blocks.push_back(BlockOf(s0, b));
-      block.manifolds.push_back(ManifoldOf(b));
-      keep(BlockOf(s0, b));
-    }
-    SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(block));
-  }
+  // Every kept term on the leaving state, whichever scan took it over (a
+  // term may name several window states: loop closures, relocalization).
+  SWARMLIO_RETURN_IF_ERROR(AddTermsNaming(s0, &kept));
   MarginalizationPrior system;
   SWARMLIO_RETURN_IF_ERROR(marginalizer->Marginalize({s0.ego.data()}, kept, &system));
   // The teammate blocks random-walk over the interval [s0, s1] as in the
@@ -343,6 +395,7 @@ Status WindowSmoother::Impl::MarginalizeOldest(std::vector<LeavingScan>* leaving
   AddTeammateRandomWalk(s1.imu->SumOfSquaredSteps(), &system);
   SWARMLIO_RETURN_IF_ERROR(SetPrior(std::move(system)));
   ++counters.marginalizations;
+  DropTermsNaming(&s0);
   Leave(&s0, leaving);
   scans.pop_front();
   scans.front()->imu_factor.reset();

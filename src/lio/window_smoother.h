@@ -13,7 +13,10 @@
 //   - the point-to-plane terms of every scan in the window, re-associated
 //     against the map at each outer iteration and handed to Ceres in
 //     information form (PoseInformationFactor, as the filter does);
-//   - the scan-stage hooks' observation factors, kept at their scan's state.
+//   - the scan-stage hooks' residual terms (observations; any term naming
+//     window states by StateKey::EgoAt), taken over with the newest scan
+//     (Ego() rewritten to EgoAt(its stamp)) and kept until the first state
+//     they name is marginalized.
 // Per scan: AddState (the new state; the oldest beyond K is marginalized
 // and handed back for the map), then Solve (undamped Gauss-Newton, one Ceres
 // step per outer iteration, like EsikfUpdate), which returns the newest
@@ -110,10 +113,13 @@ class WindowSmoother {
 
   /// Adds the newest state; the states beyond K are marginalized and
   /// appended to `*leaving` (oldest first). `*marginalize_s`: time spent [s].
-  /// A hook model whose terms cannot be kept (or do not match the state) is
-  /// left out and named in `*model_error` ("" otherwise). An error (a prior
-  /// that is not positive definite, a failed marginalization) empties the
-  /// window into `*leaving`; the next state restarts it.
+  /// A hook model whose terms cannot be kept is left out, and so is a term
+  /// that does not match its state blocks or names a state the window does
+  /// not hold (a marginalized or never-added EgoAt stamp, an absent
+  /// teammate); `*model_error` names the last such model and key ("" if
+  /// none). An error (a prior that is not positive definite, a failed
+  /// marginalization) empties the window into `*leaving`; the next state
+  /// restarts it.
   Status AddState(WindowStateInput input, std::vector<LeavingScan>* leaving,
                   double* marginalize_s, std::string* model_error);
   /// The map was empty: the newest scan was inserted at its prediction and

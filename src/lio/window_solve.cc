@@ -136,10 +136,7 @@ Status WindowSmoother::Impl::NewestCovariance(Eigen::MatrixXd* P) const {
     for (const OwnedResidualTerm& term : s.observations) {
       std::vector<double*> blocks;
       std::vector<const ceres::Manifold*> manifolds;
-      for (int b : term.blocks) {
-        blocks.push_back(BlockOf(s, b));
-        manifolds.push_back(ManifoldOf(b));
-      }
+      BlocksOf(term, &blocks, &manifolds);
       ok = ok && add(*term.cost, blocks, manifolds);
     }
   }
@@ -192,7 +189,7 @@ int WindowSmoother::Impl::AddResidualBlocks(const std::vector<WindowScan*>& acti
   for (auto& s : scans) {
     for (const OwnedResidualTerm& term : s->observations) {
       std::vector<double*> blocks;
-      for (int b : term.blocks) blocks.push_back(BlockOf(*s, b));
+      BlocksOf(term, &blocks, nullptr);
       problem->AddResidualBlock(term.cost.get(), nullptr, blocks);
       ++num_measurement_blocks;
     }

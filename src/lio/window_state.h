@@ -54,7 +54,9 @@ struct WindowScan {
   AssociationStats stats;
   std::unique_ptr<ImuPreintegration> imu;  // from the previous state (none for the first)
   std::unique_ptr<ImuPreintegrationFactor> imu_factor;
-  std::vector<OwnedResidualTerm> observations;  // the hooks' terms at this state
+  // The hooks' terms taken over with this scan, every ego key an EgoAt (Ego()
+  // rewritten to this scan's stamp); they may name earlier states too.
+  std::vector<OwnedResidualTerm> observations;
 
   EgoState State() const { return EgoState::FromParameters(ego.data()); }
   // The plane information of a successful solve, linearized at the current value.
@@ -74,9 +76,10 @@ struct TeammateBlock {
   TeammateParameters x{};
 };
 
-// The window's one prior, over the oldest ego state and every teammate block:
-// the first state's (from the filter's prediction), then each
-// marginalization's; a new teammate's block is appended to it.
+// The window's one prior, over the oldest ego state and every teammate block
+// (and any later state a marginalized term named): the first state's (from
+// the filter's prediction), then each marginalization's; a new teammate's
+// block is appended to it.
 struct Prior {
   MarginalizationPrior system;  // H*, b*, the blocks and their linearization points
   std::unique_ptr<MarginalizationPriorFactor> factor;
@@ -127,7 +130,18 @@ struct WindowSmoother::Impl {
   Status Restart(WindowStateInput* input, std::vector<LeavingScan>* leaving);
   Status SyncTeammates(const SwarmState& x_pred, const Eigen::MatrixXd& P_pred);
   Status RemoveTeammate(int id);
+  // Adds every kept term that names the leaving state s0 to the
+  // marginalizer (window order: s0's own terms first) and their other
+  // blocks to `kept`.
+  Status AddTermsNaming(const WindowScan& s0, std::vector<double*>* kept);
+  // After s0's marginalization: the terms that named it leave every scan;
+  // s0's terms that did not move to the next scan.
+  void DropTermsNaming(WindowScan* s0);
   Status MarginalizeOldest(std::vector<LeavingScan>* leaving);
+  // Checks a term handed over with the scan at `stamp_ns` and rewrites its
+  // Ego() keys to EgoAt(stamp_ns): every key must name a block the window
+  // holds, with the cost's block size; the error names the model and key.
+  Status AdoptTerm(int64_t stamp_ns, const char* model, OwnedResidualTerm* term) const;
   Status TakeObservations(WindowStateInput* input, WindowScan* scan);
   Status AddState(WindowStateInput* input, std::vector<LeavingScan>* leaving,
                   std::string* model_error);
@@ -159,12 +173,42 @@ struct WindowSmoother::Impl {
   void ReadState(SwarmState* x) const;
   std::vector<double> Values() const;
   void Restore(const std::vector<double>& values);
-  double* BlockOf(const WindowScan& scan, int block) const {
-    return block == kEgoBlock ? const_cast<double*>(scan.ego.data()) : Teammate(block);
+  // The scan whose state is at `stamp_ns`, nullptr if none in the window.
+  // Newest first: the scan being added is found even if (against the
+  // odometry's strictly increasing scan ends) an older state had its stamp.
+  WindowScan* ScanAt(int64_t stamp_ns) const {
+    for (auto it = scans.rbegin(); it != scans.rend(); ++it) {
+      if ((*it)->stamp_ns == stamp_ns) return it->get();
+    }
+    return nullptr;
   }
-  const ceres::Manifold* ManifoldOf(int block) const {
-    return block == kEgoBlock ? static_cast<const ceres::Manifold*>(&ego_manifold)
-                              : &teammate_manifold;
+  // The parameter block a key of a kept term names (EgoAt(t): the window
+  // state at t; Extrinsic(id): the teammate block); nullptr when the window
+  // does not hold it (and for Ego(), which no kept term holds).
+  double* BlockOf(const StateKey& key) const {
+    switch (key.kind()) {
+      case StateKey::Kind::kEgoAt: {
+        WindowScan* s = ScanAt(key.stamp_ns());
+        return s == nullptr ? nullptr : s->ego.data();
+      }
+      case StateKey::Kind::kTeammateExtrinsic:
+        return Teammate(key.teammate_id());
+      case StateKey::Kind::kEgo:
+        break;
+    }
+    return nullptr;
+  }
+  const ceres::Manifold* ManifoldOf(const StateKey& key) const {
+    return key.is_ego() ? static_cast<const ceres::Manifold*>(&ego_manifold)
+                        : &teammate_manifold;
+  }
+  // A kept term's parameter blocks and manifolds, in its key order.
+  void BlocksOf(const OwnedResidualTerm& term, std::vector<double*>* blocks,
+                std::vector<const ceres::Manifold*>* manifolds) const {
+    for (const StateKey& key : term.blocks) {
+      blocks->push_back(BlockOf(key));
+      if (manifolds != nullptr) manifolds->push_back(ManifoldOf(key));
+    }
   }
 };
 

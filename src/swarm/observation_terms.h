@@ -40,7 +40,7 @@ class MutualObservationModel final : public MeasurementModel {
     costs_.clear();
     blocks_.clear();
   }
-  void Add(std::unique_ptr<ceres::CostFunction> cost, std::vector<int> blocks) {
+  void Add(std::unique_ptr<ceres::CostFunction> cost, std::vector<StateKey> blocks) {
     costs_.push_back(std::move(cost));
     blocks_.push_back(std::move(blocks));
   }
@@ -48,7 +48,7 @@ class MutualObservationModel final : public MeasurementModel {
 
  private:
   std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
-  std::vector<std::vector<int>> blocks_;
+  std::vector<std::vector<StateKey>> blocks_;
 };
 
 // A covariance from the network or the detector, made symmetric positive

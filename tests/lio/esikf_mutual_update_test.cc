@@ -133,7 +133,7 @@ void MakeProblem(unsigned seed, bool third, const std::vector<int>& observed, Pr
                                                          pr->x_hat.teammate(j).R_Gi_Gj());
       const Eigen::Matrix3d A = pr->x_hat.ego.R_G_b().transpose() * pr->x_hat.teammate(j).R_Gi_Gj();
       a.S = obs + A * cov_p * A.transpose();
-      pr->terms.terms_.push_back({f.get(), {kEgoBlock, j}});
+      pr->terms.terms_.push_back({f.get(), {StateKey::Ego(), StateKey::Extrinsic(j)}});
       pr->costs.push_back(std::move(f));
       pr->active.push_back(a);
     }
@@ -156,7 +156,7 @@ void MakeProblem(unsigned seed, bool third, const std::vector<int>& observed, Pr
     const Eigen::Vector3d h0 = p.R_Gj_bj.transpose() * (w0 - p.p_bj_in_Gj);
     p.S = obs + so3::Hat(h0) * cov_th * so3::Hat(h0).transpose() +
           p.R_Gj_bj.transpose() * cov_p * p.R_Gj_bj;
-    pr->terms.terms_.push_back({f.get(), {kEgoBlock, j}});
+    pr->terms.terms_.push_back({f.get(), {StateKey::Ego(), StateKey::Extrinsic(j)}});
     pr->costs.push_back(std::move(f));
     pr->passive.push_back(p);
   }

@@ -37,7 +37,9 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,18 +128,23 @@ class EsikfUpdate {
   /// `considered_teammates`: ids (in the layout, none also estimated) whose
   /// blocks the residuals may name but the update does not correct (file
   /// comment). With estimated_teammates nullptr, every teammate not
-  /// considered is estimated.
+  /// considered is estimated. `stamp_ns`: the time of x_hat (the scan end
+  /// [ns]); the models' terms may name the ego state as StateKey::Ego() or
+  /// EgoAt(stamp_ns), any other EgoAt is InvalidArgument (the filter holds
+  /// one state; without a stamp every EgoAt is).
   EsikfUpdateResult Run(const SwarmState& x_hat,
                         const Eigen::MatrixXd& P_hat,
                         const std::vector<MeasurementModel*>& models,
                         const std::vector<int>* estimated_teammates = nullptr,
-                        const std::vector<int>* considered_teammates = nullptr) const;
+                        const std::vector<int>* considered_teammates = nullptr,
+                        std::optional<int64_t> stamp_ns = std::nullopt) const;
   EsikfUpdateResult RunFrom(const SwarmState& x_hat,
                             const Eigen::MatrixXd& P_hat,
                             const SwarmState& x_start,
                             const std::vector<MeasurementModel*>& models,
                             const std::vector<int>* estimated_teammates = nullptr,
-                            const std::vector<int>* considered_teammates = nullptr) const;
+                            const std::vector<int>* considered_teammates = nullptr,
+                            std::optional<int64_t> stamp_ns = std::nullopt) const;
 
   const EsikfUpdateOptions& options() const { return options_; }
 
@@ -149,7 +156,8 @@ class EsikfUpdate {
   EsikfUpdateResult RunAll(const SwarmState& x_hat, const Eigen::MatrixXd& P_hat,
                            const SwarmState& x_start,
                            const std::vector<MeasurementModel*>& models,
-                           const std::vector<int>& held = {}) const;
+                           const std::vector<int>& held = {},
+                           std::optional<int64_t> stamp_ns = std::nullopt) const;
   EsikfUpdateOptions options_;
 };
 

@@ -8,11 +8,13 @@
 // residuals from one iteration to the next.
 //
 // Conventions of a residual block: the residual is whitened (|r|^2 is the
-// Mahalanobis distance of the measurement), its parameter blocks are the ego
-// block (EgoState ambient, 19) and/or teammate blocks (GlobalExtrinsic
-// ambient, 7), in the order of `blocks`. The posterior covariance is formed
-// from the tangent Jacobians of all blocks, so a model need not provide
-// anything else.
+// Mahalanobis distance of the measurement), its parameter blocks are ego
+// states (EgoState ambient, 19) and/or teammate blocks (GlobalExtrinsic
+// ambient, 7), named by StateKey (state_key.h) in the order of `blocks`:
+// StateKey::Ego() for the state of the scan being updated, EgoAt(t) for the
+// ego state at another scan end the back end holds, Extrinsic(id) for a
+// teammate. The posterior covariance is formed from the tangent Jacobians of
+// all blocks, so a model need not provide anything else.
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -23,27 +25,26 @@
 #include <vector>
 
 #include "swarmlio/common/status.h"
+#include "swarmlio/lio/state_key.h"
 #include "swarmlio/state/swarm_state.h"
 
 namespace swarmlio {
 
-/// The ego block in ResidualTerm::blocks.
-inline constexpr int kEgoBlock = -1;
-
 /// One residual block a model contributes at one iteration.
 struct ResidualTerm {
   const ceres::CostFunction* cost = nullptr;  // owned by the model, valid until its next Linearize
-  /// State blocks in the cost's parameter order: kEgoBlock or a teammate id.
-  std::vector<int> blocks;
+  /// State blocks in the cost's parameter order.
+  std::vector<StateKey> blocks;
 };
 
 /// A residual block handed over for good, to a back end that keeps it after
 /// its scan (the fixed-lag window smoother, docs/window.md).
 struct OwnedResidualTerm {
   std::unique_ptr<ceres::CostFunction> cost;
-  /// State blocks in the cost's parameter order: kEgoBlock (the block of the
-  /// scan the model belongs to) or a teammate id.
-  std::vector<int> blocks;
+  /// State blocks in the cost's parameter order; Ego() is the state of the
+  /// scan the model belongs to (the window rewrites it to EgoAt(that scan's
+  /// stamp) when it takes the term over).
+  std::vector<StateKey> blocks;
 };
 
 class MeasurementModel {
@@ -53,7 +54,8 @@ class MeasurementModel {
   virtual const char* name() const = 0;
   /// Re-linearizes at `x` and appends this iteration's residual blocks to
   /// `*terms` (none is fine: e.g. no plane found). Blocks may name only
-  /// teammates present in x's layout. A non-ok Status aborts the update.
+  /// teammates present in x's layout and ego states the back end holds. A
+  /// non-ok Status aborts the update.
   virtual Status Linearize(const SwarmState& x, std::vector<ResidualTerm>* terms) = 0;
   /// Optional fast path for the posterior covariance: adds J^T J of the
   /// residual blocks of the last Linearize, evaluated at `x`, in the tangent
