@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "factors/point_to_plane_factor.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/plane_fit.h"
 #include "swarmlio/state/swarm_state.h"

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/teammate/association.h"
 #include "swarmlio/teammate/clustering.h"
 #include "swarmlio/teammate/observation.h"
