@@ -13,7 +13,7 @@ constexpr uint8_t kLargestMask = 0x03;
 constexpr uint8_t kDegeneratedFlag = 0x04;
 constexpr int kCountShift = 3;
 
-Status DecodeObservation(WireReader* r, TeammateObservation* o) {
+Status DecodeObservation(WireReader* r, CurrentObservation* o) {
   uint8_t id = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("observed_id", &id));
   o->observed_id = id;
@@ -73,7 +73,7 @@ void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
     w->U16(m.offset_report->offset_residue);
     w->U8(static_cast<uint8_t>(m.offset_report->std_code));
   }
-  for (const TeammateObservation& o : m.observations) {
+  for (const CurrentObservation& o : m.observations) {
     w->U8(static_cast<uint8_t>(o.observed_id));
     WriteScaledVectorI16(o.p_bk_in_bj, kObservationPositionStepM, w);
     WriteCovariance<3>(o.cov_p_bk_in_bj, w);
