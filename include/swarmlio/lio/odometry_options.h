@@ -31,7 +31,7 @@ struct OdometryOptions {
   ImuPropagatorOptions propagation;
   PreprocessOptions preprocess;
   LocalMapOptions map;
-  AssociationOptions association;
+  ScanAssociationOptions association;
   EsikfUpdateOptions update;
   /// The window smoother (used when estimator is window).
   WindowOptions window;

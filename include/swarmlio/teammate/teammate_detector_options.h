@@ -19,7 +19,7 @@ namespace swarmlio::teammate {
 
 struct TeammateDetectorOptions {
   ClusteringOptions clustering;
-  AssociationOptions association;
+  TrackAssociationOptions association;
   TemporaryTrackerOptions temporary;
   ExcitationOptions excitation;
   MatchingOptions matching;
