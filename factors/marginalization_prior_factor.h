@@ -76,8 +76,8 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 
 namespace swarmlio {
 

@@ -30,7 +30,7 @@ size_t NearestStamp(const std::vector<double>& sorted_s, double t_s) {
 
 Status AssociateTrajectories(const Trajectory& reference,
                              const Trajectory& estimate,
-                             const AssociationOptions& options,
+                             const TrajectoryAssociationOptions& options,
                              AssociatedTrajectories* result) {
   if (!std::isfinite(options.max_time_diff_s) || options.max_time_diff_s < 0.0) {
     return Status::InvalidArgument("association: max_time_diff_s must be finite and >= 0, got " +

@@ -7,7 +7,7 @@ namespace swarmlio::io::internal {
 
 Status ParseHeaderFields(const uint8_t* data, size_t size, HeaderFields* fields) {
   fields->clear();
-  WireReader reader(data, size);
+  RosMessageReader reader(data, size);
   while (reader.remaining() > 0) {
     std::string field;
     SWARMLIO_RETURN_IF_ERROR(reader.ReadString("record header field", &field));

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "src/io/wire_reader.h"
+#include "src/io/ros_message_reader.h"
 #include "swarmlio/common/status.h"
 
 namespace swarmlio::io::internal {

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "src/io/header_codec.h"
+#include "src/io/ros_message_reader.h"
 #include "src/io/ros_time.h"
-#include "src/io/wire_reader.h"
 
 namespace swarmlio::io::internal {
 namespace {
@@ -22,7 +22,7 @@ uint8_t ReflectivityToByte(float reflectivity) {
 }  // namespace
 
 Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, LidarScan* scan) {
-  WireReader reader(data, size);
+  RosMessageReader reader(data, size);
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &scan->stamp_ns, &scan->frame_id));
   uint32_t point_num = 0;
   SWARMLIO_RETURN_IF_ERROR(reader.ReadU64("timebase", &scan->livox_timebase_ns));

@@ -2,7 +2,7 @@
 
 namespace swarmlio::io::internal {
 
-Status ReadRosHeader(WireReader* reader, int64_t* stamp_ns, std::string* frame_id) {
+Status ReadRosHeader(RosMessageReader* reader, int64_t* stamp_ns, std::string* frame_id) {
   uint32_t seq = 0;
   uint32_t sec = 0;
   uint32_t nsec = 0;

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-#include "src/io/wire_reader.h"
+#include "src/io/ros_message_reader.h"
 #include "swarmlio/common/status.h"
 
 namespace swarmlio::io::internal {
@@ -15,6 +15,6 @@ inline int64_t StampNsFromRos(uint32_t sec, uint32_t nsec) {
 }
 
 /// Reads std_msgs/Header (uint32 seq, time stamp, string frame_id).
-Status ReadRosHeader(WireReader* reader, int64_t* stamp_ns, std::string* frame_id);
+Status ReadRosHeader(RosMessageReader* reader, int64_t* stamp_ns, std::string* frame_id);
 
 }  // namespace swarmlio::io::internal

@@ -1,19 +1,19 @@
 #include "src/io/imu_codec.h"
 
 #include "src/io/header_codec.h"
+#include "src/io/ros_message_reader.h"
 #include "src/io/ros_time.h"
-#include "src/io/wire_reader.h"
 
 namespace swarmlio::io::internal {
 namespace {
 
-Status ReadVector3(WireReader* reader, const char* field, Eigen::Vector3d* v) {
+Status ReadVector3(RosMessageReader* reader, const char* field, Eigen::Vector3d* v) {
   for (int i = 0; i < 3; ++i) SWARMLIO_RETURN_IF_ERROR(reader->ReadF64(field, &(*v)[i]));
   return Status::Ok();
 }
 
 // Skips a fixed-size float64 array of `count` elements.
-Status SkipFloat64s(WireReader* reader, const char* field, size_t count) {
+Status SkipFloat64s(RosMessageReader* reader, const char* field, size_t count) {
   const uint8_t* unused = nullptr;
   return reader->ReadBytes(field, count * 8, &unused);
 }
@@ -21,7 +21,7 @@ Status SkipFloat64s(WireReader* reader, const char* field, size_t count) {
 }  // namespace
 
 Status DecodeImu(const uint8_t* data, size_t size, ImuSample* imu) {
-  WireReader reader(data, size);
+  RosMessageReader reader(data, size);
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &imu->stamp_ns, &imu->frame_id));
   SWARMLIO_RETURN_IF_ERROR(SkipFloat64s(&reader, "orientation", 4));
   SWARMLIO_RETURN_IF_ERROR(SkipFloat64s(&reader, "orientation_covariance", 9));

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::io::internal {
 namespace {

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "src/io/header_codec.h"
+#include "src/io/ros_message_reader.h"
 #include "src/io/ros_time.h"
-#include "src/io/wire_reader.h"
 
 namespace swarmlio::io::internal {
 namespace {
@@ -166,7 +166,7 @@ Status DecodePointCloud2(const uint8_t* data,
                          const PointCloud2DecodeOptions& options,
                          LidarScan* scan,
                          PointCloud2DecodeInfo* info) {
-  WireReader reader(data, size);
+  RosMessageReader reader(data, size);
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &scan->stamp_ns, &scan->frame_id));
   scan->livox_timebase_ns = 0;
   scan->livox_lidar_id = 0;

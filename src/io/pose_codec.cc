@@ -3,8 +3,8 @@
 #include <string>
 
 #include "src/io/header_codec.h"
+#include "src/io/ros_message_reader.h"
 #include "src/io/ros_time.h"
-#include "src/io/wire_reader.h"
 
 namespace swarmlio::io::internal {
 namespace {
@@ -15,7 +15,7 @@ constexpr size_t kCovarianceBytes = 36 * 8;
 constexpr size_t kTwistBytes = 6 * 8;
 
 // geometry_msgs/Pose: position x y z, orientation x y z w.
-Status ReadPose(WireReader* reader,
+Status ReadPose(RosMessageReader* reader,
                 const char* position,
                 const char* orientation,
                 PoseStamped* pose) {
@@ -32,14 +32,14 @@ Status ReadPose(WireReader* reader,
 }  // namespace
 
 Status DecodePoseStamped(const uint8_t* data, size_t size, PoseStamped* pose) {
-  WireReader reader(data, size);
+  RosMessageReader reader(data, size);
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &pose->stamp_ns, &pose->frame_id));
   SWARMLIO_RETURN_IF_ERROR(ReadPose(&reader, "pose.position", "pose.orientation", pose));
   return reader.ExpectEnd("geometry_msgs/PoseStamped");
 }
 
 Status DecodeOdometryPose(const uint8_t* data, size_t size, PoseStamped* pose) {
-  WireReader reader(data, size);
+  RosMessageReader reader(data, size);
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &pose->stamp_ns, &pose->frame_id));
   std::string child_frame_id;
   SWARMLIO_RETURN_IF_ERROR(reader.ReadString("child_frame_id", &child_frame_id));

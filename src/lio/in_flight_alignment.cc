@@ -34,11 +34,11 @@ Status DoubleIntegrateSpecificForce(const ImuSample& start,
                                     const std::vector<ImuSample>& samples,
                                     double acceleration_to_m_s2,
                                     const Eigen::Vector3d& gyro_bias_rad_s,
-                                    const std::vector<StampedPosition>& poses,
+                                    const std::vector<StampedPose>& poses,
                                     std::vector<Eigen::Vector3d>* double_integrals) {
   double_integrals->clear();
   std::vector<int64_t> stamps_ns;
-  for (const StampedPosition& p : poses) stamps_ns.push_back(p.stamp_ns);
+  for (const StampedPose& p : poses) stamps_ns.push_back(p.stamp_ns);
   if (stamps_ns.empty()) return Status::Ok();
   if (samples.empty() || stamps_ns.front() <= start.stamp_ns ||
       stamps_ns.back() > samples.back().stamp_ns) {
@@ -81,7 +81,7 @@ Status AlignVelocityAndGravity(const ImuSample& start,
                                const std::vector<ImuSample>& samples,
                                double acceleration_to_m_s2,
                                const Eigen::Vector3d& gyro_bias_rad_s,
-                               const std::vector<StampedPosition>& positions,
+                               const std::vector<StampedPose>& positions,
                                double position_stddev_floor_m,
                                VelocityGravityAlignment* result) {
   const int n = static_cast<int>(positions.size());

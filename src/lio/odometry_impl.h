@@ -30,7 +30,7 @@ struct InFlightProbe {
   ImuInitialization start;                              // the current pass's initial state (at t0)
   std::vector<ImuSample> imu;                           // every sample after t0
   std::vector<PendingScan> scans;                       // every queued scan since t0
-  std::vector<StampedPosition> positions;               // the current pass's updated scans
+  std::vector<StampedPose> positions;                   // the current pass's updated scans
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // its last posterior b_g
   OdometryCounters counters;                            // the counters when the probe started
 };

@@ -11,7 +11,7 @@ double AssociationStats::MinNormalInformation() const {
       .eigenvalues()(0);
 }
 
-ScanAssociator::ScanAssociator(const LocalMap* map, const AssociationOptions& options)
+ScanAssociator::ScanAssociator(const LocalMap* map, const ScanAssociationOptions& options)
     : map_(map), options_(options) {}
 
 void ScanAssociator::Reset(const std::vector<Eigen::Vector3d>* points_in_b) {

@@ -13,7 +13,7 @@ WindowSmoother::WindowSmoother() : impl_(std::make_unique<Impl>()) {}
 WindowSmoother::~WindowSmoother() = default;
 
 Status WindowSmoother::Create(const WindowOptions& options, const ImuPropagatorOptions& propagation,
-                              const AssociationOptions& association,
+                              const ScanAssociationOptions& association,
                               const EsikfUpdateOptions& update, const LocalMap* map,
                               std::unique_ptr<WindowSmoother>* smoother) {
   if (const std::string invalid = options.Validate(); !invalid.empty()) {

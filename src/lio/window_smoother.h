@@ -96,7 +96,7 @@ class WindowSmoother {
   /// InvalidArgument when the options do not validate. `map` must outlive
   /// the smoother; the odometry inserts the scans that leave.
   static Status Create(const WindowOptions& options, const ImuPropagatorOptions& propagation,
-                       const AssociationOptions& association, const EsikfUpdateOptions& update,
+                       const ScanAssociationOptions& association, const EsikfUpdateOptions& update,
                        const LocalMap* map, std::unique_ptr<WindowSmoother>* smoother);
   ~WindowSmoother();
 

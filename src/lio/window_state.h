@@ -94,7 +94,7 @@ struct WindowSmoother::Impl {
   WindowOptions options;
   ImuPreintegrationOptions preintegration;
   ProcessNoiseOptions process_noise;  // the propagator's (teammate random walks)
-  AssociationOptions association;
+  ScanAssociationOptions association;
   EsikfUpdateOptions update;
   const LocalMap* map = nullptr;
   EgoStateManifold ego_manifold;

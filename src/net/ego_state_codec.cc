@@ -13,7 +13,7 @@ constexpr uint8_t kLargestMask = 0x03;
 constexpr uint8_t kDegeneratedFlag = 0x04;
 constexpr int kCountShift = 3;
 
-Status DecodeObservation(WireReader* r, TeammateObservation* o) {
+Status DecodeObservation(PacketReader* r, CurrentObservation* o) {
   uint8_t id = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("observed_id", &id));
   o->observed_id = id;
@@ -26,7 +26,7 @@ Status DecodeObservation(WireReader* r, TeammateObservation* o) {
 /// relative to it.
 Eigen::Vector3d AsSentF32(const Eigen::Vector3d& v) { return v.cast<float>().cast<double>(); }
 
-Status DecodePastObservation(const Eigen::Vector3d& p_bj_in_Gj, WireReader* r,
+Status DecodePastObservation(const Eigen::Vector3d& p_bj_in_Gj, PacketReader* r,
                              PastObservation* o) {
   uint8_t id = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("observed_id", &id));
@@ -44,7 +44,7 @@ Status DecodePastObservation(const Eigen::Vector3d& p_bj_in_Gj, WireReader* r,
 
 }  // namespace
 
-void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
+void EncodeEgoState(const EgoStateMessage& m, PacketWriter* w) {
   const QuaternionCodes q = EncodeQuaternion(m.q_Gj_bj);
   w->I64(m.stamp_ns);
   w->I48(m.stamp_ns - m.session_start_ns);
@@ -73,7 +73,7 @@ void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
     w->U16(m.offset_report->offset_residue);
     w->U8(static_cast<uint8_t>(m.offset_report->std_code));
   }
-  for (const TeammateObservation& o : m.observations) {
+  for (const CurrentObservation& o : m.observations) {
     w->U8(static_cast<uint8_t>(o.observed_id));
     WriteScaledVectorI16(o.p_bk_in_bj, kObservationPositionStepM, w);
     WriteCovariance<3>(o.cov_p_bk_in_bj, w);
@@ -89,7 +89,7 @@ void EncodeEgoState(const EgoStateMessage& m, WireWriter* w) {
   }
 }
 
-Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* out) {
+Status DecodeEgoState(int sender_id, PacketReader* r, EgoStateMessage* out) {
   EgoStateMessage m;
   m.sender_id = sender_id;
   SWARMLIO_RETURN_IF_ERROR(r->I64("stamp_ns", &m.stamp_ns));

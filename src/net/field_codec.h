@@ -1,7 +1,7 @@
 // Wire helpers shared by the payload codecs: the field encodings of
 // wire_format.h (float32 and float16 vectors, scaled int16 vectors,
 // smallest-three quaternions, log-variance / partial-correlation covariances)
-// on top of WireWriter / WireReader. Readers check every decoded code's range
+// on top of PacketWriter / PacketReader. Readers check every decoded code's range
 // and return DataLoss naming the field.
 #pragma once
 
@@ -12,39 +12,39 @@
 
 #include "src/net/covariance_codec.h"
 #include "src/net/half_float.h"
+#include "src/net/packet_reader.h"
+#include "src/net/packet_writer.h"
 #include "src/net/quaternion_codec.h"
-#include "src/net/wire_reader.h"
-#include "src/net/wire_writer.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/net/wire_format.h"
 
 namespace swarmlio::net::internal {
 
-inline void WriteVectorF32(const Eigen::Vector3d& v, WireWriter* w) {
+inline void WriteVectorF32(const Eigen::Vector3d& v, PacketWriter* w) {
   for (int i = 0; i < 3; ++i) w->F32(v[i]);
 }
-inline Status ReadVectorF32(const char* field, WireReader* r, Eigen::Vector3d* v) {
+inline Status ReadVectorF32(const char* field, PacketReader* r, Eigen::Vector3d* v) {
   for (int i = 0; i < 3; ++i) SWARMLIO_RETURN_IF_ERROR(r->F32(field, i, &(*v)[i]));
   return Status::Ok();
 }
 
 /// Precondition: FitsHalf for every coefficient.
-inline void WriteVectorF16(const Eigen::Vector3d& v, WireWriter* w) {
+inline void WriteVectorF16(const Eigen::Vector3d& v, PacketWriter* w) {
   for (int i = 0; i < 3; ++i) w->U16(HalfFromDouble(v[i]));
 }
-inline Status ReadVectorF16(const char* field, WireReader* r, Eigen::Vector3d* v) {
+inline Status ReadVectorF16(const char* field, PacketReader* r, Eigen::Vector3d* v) {
   for (int i = 0; i < 3; ++i) SWARMLIO_RETURN_IF_ERROR(r->F16(field, i, &(*v)[i]));
   return Status::Ok();
 }
 
 /// int16 codes round(v / step); precondition: |v / step| rounds to <= 32767.
-inline void WriteScaledVectorI16(const Eigen::Vector3d& v, double step, WireWriter* w) {
+inline void WriteScaledVectorI16(const Eigen::Vector3d& v, double step, PacketWriter* w) {
   for (int i = 0; i < 3; ++i) w->I16(static_cast<int16_t>(std::lround(v[i] / step)));
 }
 /// Rejects the code -32768 (the range is symmetric, +-32767 steps).
 inline Status ReadScaledVectorI16(const char* field,
                                   double step,
-                                  WireReader* r,
+                                  PacketReader* r,
                                   Eigen::Vector3d* v) {
   for (int i = 0; i < 3; ++i) {
     int16_t code = 0;
@@ -56,13 +56,13 @@ inline Status ReadScaledVectorI16(const char* field,
 }
 
 /// The three sent coefficients; codes.largest travels in the caller's flags byte.
-inline void WriteQuaternion(const QuaternionCodes& codes, WireWriter* w) {
+inline void WriteQuaternion(const QuaternionCodes& codes, PacketWriter* w) {
   for (int16_t c : codes.sent) w->I16(c);
 }
 /// Error messages index the sent codes [0..2].
 inline Status ReadQuaternion(const char* field,
                              uint8_t largest,
-                             WireReader* r,
+                             PacketReader* r,
                              Eigen::Quaterniond* q) {
   QuaternionCodes codes;
   codes.largest = largest;
@@ -78,14 +78,14 @@ inline Status ReadQuaternion(const char* field,
 /// Precondition: the upper triangle is finite, the diagonal in
 /// [0, MaxEncodableVariance()] (CheckMessage).
 template <int N>
-void WriteCovariance(const Eigen::Matrix<double, N, N>& m, WireWriter* w) {
+void WriteCovariance(const Eigen::Matrix<double, N, N>& m, PacketWriter* w) {
   uint8_t codes[CovarianceBytes(N)];
   EncodeCovariance<N>(m, codes);
   for (uint8_t c : codes) w->U8(c);
 }
 /// Error messages index the codes in wire order (variances, then correlations).
 template <int N>
-Status ReadCovariance(const char* field, WireReader* r, Eigen::Matrix<double, N, N>* m) {
+Status ReadCovariance(const char* field, PacketReader* r, Eigen::Matrix<double, N, N>* m) {
   uint8_t codes[CovarianceBytes(N)];
   for (size_t i = 0; i < CovarianceBytes(N); ++i) {
     SWARMLIO_RETURN_IF_ERROR(r->U8(field, static_cast<int>(i), &codes[i]));

@@ -13,7 +13,7 @@ constexpr uint8_t kLargestMask = 0x03;
 constexpr uint8_t kGraphSourceFlag = 0x04;
 constexpr uint8_t kKnownBits = kLargestMask | kGraphSourceFlag;
 
-Status DecodeEntry(WireReader* r, GlobalExtrinsicEntry* e) {
+Status DecodeEntry(PacketReader* r, GlobalExtrinsicEntry* e) {
   uint8_t id = 0;
   uint8_t bits = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("teammate_id", &id));
@@ -31,7 +31,7 @@ Status DecodeEntry(WireReader* r, GlobalExtrinsicEntry* e) {
 
 }  // namespace
 
-void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& m, WireWriter* w) {
+void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& m, PacketWriter* w) {
   w->I64(m.stamp_ns);
   WriteVectorF32(m.g_in_Gi, w);
   WriteCovariance<3>(m.cov_g_in_Gi, w);
@@ -47,7 +47,7 @@ void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& m, WireWriter* w) {
   }
 }
 
-Status DecodeGlobalExtrinsic(int sender_id, WireReader* r, GlobalExtrinsicMessage* out) {
+Status DecodeGlobalExtrinsic(int sender_id, PacketReader* r, GlobalExtrinsicMessage* out) {
   GlobalExtrinsicMessage m;
   m.sender_id = sender_id;
   SWARMLIO_RETURN_IF_ERROR(r->I64("stamp_ns", &m.stamp_ns));

@@ -162,7 +162,7 @@ Status Check(const EgoStateMessage& m) {
   uint64_t seen = 0;
   for (size_t i = 0; i < m.observations.size() && c.ok(); ++i) {
     c.SetContext("observations[" + std::to_string(i) + "].");
-    const TeammateObservation& o = m.observations[i];
+    const CurrentObservation& o = m.observations[i];
     c.TeammateId("observed_id", o.observed_id, m.sender_id, &seen);
     c.ObservationPosition("p_bk_in_bj", o.p_bk_in_bj);
     c.Covariance<3>("cov_p_bk_in_bj", o.cov_p_bk_in_bj);

@@ -7,9 +7,9 @@
 #include <string>
 #include <type_traits>
 
+#include "src/net/packet_reader.h"
+#include "src/net/packet_writer.h"
 #include "src/net/payload_codecs.h"
-#include "src/net/wire_reader.h"
-#include "src/net/wire_writer.h"
 
 namespace swarmlio::net {
 
@@ -43,7 +43,7 @@ Status PacketCodec::Encode(const SwarmMessage& message,
 
   std::vector<uint8_t> bytes;
   bytes.reserve(kMaxPacketBytes);
-  internal::WireWriter w(&bytes);
+  internal::PacketWriter w(&bytes);
   w.U8(kMagic);
   w.U8(kProtocolVersion);
   w.U8(static_cast<uint8_t>(TypeOf(message)));
@@ -82,7 +82,7 @@ Status PacketCodec::Decode(const uint8_t* data, size_t size, DecodedPacket* pack
     return Status::DataLoss("packet of " + std::to_string(size) + " bytes exceeds the cap of " +
                             std::to_string(kMaxPacketBytes));
   }
-  internal::WireReader header_reader(data, kHeaderBytes);
+  internal::PacketReader header_reader(data, kHeaderBytes);
   uint8_t magic = 0, version = 0, type = 0, sender = 0;
   uint16_t sequence = 0;
   PacketHeader header;
@@ -115,7 +115,7 @@ Status PacketCodec::Decode(const uint8_t* data, size_t size, DecodedPacket* pack
   header.sequence = sequence;
   header.payload_bytes = static_cast<uint16_t>(signed_bytes - kHeaderBytes);
 
-  internal::WireReader r(data + kHeaderBytes, header.payload_bytes);
+  internal::PacketReader r(data + kHeaderBytes, header.payload_bytes);
   DecodedPacket decoded;
   decoded.header = header;
   switch (header.type) {

@@ -8,21 +8,21 @@
 #include <cstdint>
 #include <vector>
 
-#include "src/net/wire_reader.h"
-#include "src/net/wire_writer.h"
+#include "src/net/packet_reader.h"
+#include "src/net/packet_writer.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/net/messages.h"
 
 namespace swarmlio::net::internal {
 
-void EncodeEgoState(const EgoStateMessage& message, WireWriter* w);
+void EncodeEgoState(const EgoStateMessage& message, PacketWriter* w);
 /// `sender_id` comes from the packet header.
-Status DecodeEgoState(int sender_id, WireReader* r, EgoStateMessage* message);
+Status DecodeEgoState(int sender_id, PacketReader* r, EgoStateMessage* message);
 
-void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& message, WireWriter* w);
-Status DecodeGlobalExtrinsic(int sender_id, WireReader* r, GlobalExtrinsicMessage* message);
+void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& message, PacketWriter* w);
+Status DecodeGlobalExtrinsic(int sender_id, PacketReader* r, GlobalExtrinsicMessage* message);
 
-void EncodeTimeSync(const TimeSyncMessage& message, WireWriter* w);
-Status DecodeTimeSync(int sender_id, WireReader* r, TimeSyncMessage* message);
+void EncodeTimeSync(const TimeSyncMessage& message, PacketWriter* w);
+Status DecodeTimeSync(int sender_id, PacketReader* r, TimeSyncMessage* message);
 
 }  // namespace swarmlio::net::internal

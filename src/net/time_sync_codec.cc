@@ -5,7 +5,7 @@
 
 namespace swarmlio::net::internal {
 
-void EncodeTimeSync(const TimeSyncMessage& m, WireWriter* w) {
+void EncodeTimeSync(const TimeSyncMessage& m, PacketWriter* w) {
   w->U8(static_cast<uint8_t>(m.target_id));
   w->U8(m.is_response ? 1 : 0);
   w->I64(m.t1_ns);
@@ -13,7 +13,7 @@ void EncodeTimeSync(const TimeSyncMessage& m, WireWriter* w) {
   w->I64(m.t3_ns);
 }
 
-Status DecodeTimeSync(int sender_id, WireReader* r, TimeSyncMessage* out) {
+Status DecodeTimeSync(int sender_id, PacketReader* r, TimeSyncMessage* out) {
   TimeSyncMessage m;
   m.sender_id = sender_id;
   uint8_t target = 0;

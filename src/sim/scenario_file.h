@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/trajectory_builder.h"
 

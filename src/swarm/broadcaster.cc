@@ -225,7 +225,7 @@ void Broadcaster::AddObservations(const std::vector<int>& ids, Pass* pass) {
       return;
     }
     const teammate::TeammateObservation& o = *pass->seen.at(id);
-    net::TeammateObservation n;
+    net::CurrentObservation n;
     n.observed_id = o.drone_id;
     n.p_bk_in_bj = o.p_bj_in_bi;
     n.cov_p_bk_in_bj = o.covariance_m2;
@@ -350,7 +350,7 @@ void Broadcaster::RememberForRepeat(const net::EgoStateMessage& m, const SwarmSt
   const Eigen::Matrix3d P_pp = P.block<3, 3>(pos.offset, pos.offset);
   const Eigen::Matrix3d P_tp = P.block<3, 3>(rot.offset, pos.offset);
   repeat_stamp_ns_ = m.stamp_ns;
-  for (const net::TeammateObservation& o : m.observations) {
+  for (const net::CurrentObservation& o : m.observations) {
     if (policy == RepeatObservations::kDegenerateTeammates) {
       const auto it = registry_->teammates().find(o.observed_id);
       if (it == registry_->teammates().end() || !it->second.have_message || !it->second.last.degenerated) {

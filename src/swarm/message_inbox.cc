@@ -195,7 +195,7 @@ void MessageInbox::QueueObservations(const net::EgoStateMessage& received,
     }
     to_.passive->Queue(std::move(p));
   };
-  for (const net::TeammateObservation& o : m.observations) {
+  for (const net::CurrentObservation& o : m.observations) {
     if (o.observed_id == self_id_ && o.p_bk_in_bj.allFinite() && o.cov_p_bk_in_bj.allFinite()) {
       queue(0, o.p_bk_in_bj, o.cov_p_bk_in_bj, false);
     }

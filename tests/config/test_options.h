@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::config_test {
 

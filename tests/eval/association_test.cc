@@ -25,7 +25,7 @@ TEST(Association, KeepsPairsWithinTheToleranceInclusive) {
   // Stamps are exact binary fractions, so |dt| == tolerance is exact.
   const Trajectory reference = Stamped({0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
   const Trajectory estimate = Stamped({0.25, 1.5, 3.75, 5.375, 7.0, 20.0});
-  AssociationOptions options;
+  TrajectoryAssociationOptions options;
   options.max_time_diff_s = 0.25;
   AssociatedTrajectories result;
   ASSERT_TRUE(AssociateTrajectories(reference, estimate, options, &result).ok());
@@ -44,7 +44,7 @@ TEST(Association, KeepsPairsWithinTheToleranceInclusive) {
 }
 
 TEST(Association, DefaultToleranceIsTenMilliseconds) {
-  EXPECT_EQ(AssociationOptions().max_time_diff_s, 0.01);
+  EXPECT_EQ(TrajectoryAssociationOptions().max_time_diff_s, 0.01);
   const Trajectory reference = Stamped({10.0, 10.1, 10.2, 10.3});
   const Trajectory estimate = Stamped({10.009, 10.1115, 10.195});
   AssociatedTrajectories result;
@@ -56,7 +56,7 @@ TEST(Association, DefaultToleranceIsTenMilliseconds) {
 TEST(Association, TiesGoToTheFirstStampAndDuplicatesToTheFirstPose) {
   const Trajectory reference = Stamped({0, 1, 1, 2, 3});
   const Trajectory estimate = Stamped({1.0, 1.5});
-  AssociationOptions options;
+  TrajectoryAssociationOptions options;
   options.max_time_diff_s = 0.5;
   AssociatedTrajectories result;
   ASSERT_TRUE(AssociateTrajectories(reference, estimate, options, &result).ok());
@@ -67,7 +67,7 @@ TEST(Association, TheShorterTrajectoryIsMatchedAndLongPosesMayRepeat) {
   // The reference is shorter here: its stamps are matched into the estimate.
   const Trajectory reference = Stamped({1.0, 1.03});
   const Trajectory estimate = Stamped({1.02, 5.0, 6.0, 7.0});
-  AssociationOptions options;
+  TrajectoryAssociationOptions options;
   options.max_time_diff_s = 0.05;
   AssociatedTrajectories result;
   ASSERT_TRUE(AssociateTrajectories(reference, estimate, options, &result).ok());
@@ -79,7 +79,7 @@ TEST(Association, TheShorterTrajectoryIsMatchedAndLongPosesMayRepeat) {
 TEST(Association, EqualSizesMatchTheEstimateIntoTheReference) {
   const Trajectory reference = Stamped({0.0, 1.0, 2.0});
   const Trajectory estimate = Stamped({0.9, 1.1, 5.0});
-  AssociationOptions options;
+  TrajectoryAssociationOptions options;
   options.max_time_diff_s = 0.2;
   AssociatedTrajectories result;
   ASSERT_TRUE(AssociateTrajectories(reference, estimate, options, &result).ok());
@@ -90,7 +90,7 @@ TEST(Association, EqualSizesMatchTheEstimateIntoTheReference) {
 TEST(Association, OffsetShiftsTheEstimate) {
   const Trajectory reference = Stamped({0, 1, 2, 3, 4});
   const Trajectory estimate = Stamped({10.5, 11.5});
-  AssociationOptions options;
+  TrajectoryAssociationOptions options;
   options.max_time_diff_s = 0.0;
   options.time_offset_s = -8.5;
   AssociatedTrajectories result;
@@ -123,7 +123,7 @@ TEST(Association, UnstampedTrajectoriesPairByIndex) {
 TEST(Association, RejectsBadInput) {
   const Trajectory good = Stamped({0, 1, 2});
   AssociatedTrajectories result;
-  AssociationOptions negative;
+  TrajectoryAssociationOptions negative;
   negative.max_time_diff_s = -1.0;
   EXPECT_FALSE(AssociateTrajectories(good, good, negative, &result).ok());
   EXPECT_FALSE(AssociateTrajectories(Trajectory(), good, {}, &result).ok());

@@ -54,7 +54,7 @@ struct Flight {
 struct Data {
   ImuSample start;
   std::vector<ImuSample> samples;
-  std::vector<StampedPosition> positions;
+  std::vector<StampedPose> positions;
 };
 
 Data Make(const Flight& f, double duration_s, double noise_m, double scale = 1.0) {
@@ -68,7 +68,7 @@ Data Make(const Flight& f, double duration_s, double noise_m, double scale = 1.0
   std::normal_distribution<double> n(0.0, 1.0);
   // Scan ends off the IMU grid (sub-stepped integration).
   for (int64_t t = kT0Ns + kScanPeriodNs + 1'234'567; t <= end_ns; t += kScanPeriodNs) {
-    StampedPosition p;
+    StampedPose p;
     p.stamp_ns = t;
     const double tau = 1e-9 * static_cast<double>(t - kT0Ns);
     p.p_b_in_G = f.PositionInG(tau) + noise_m * Eigen::Vector3d(n(rng), n(rng), n(rng));
@@ -142,11 +142,11 @@ TEST(InFlightAlignment, RefusesTooFewOrTooClosePositions) {
   const Flight f;
   Data d = Make(f, 1.5, 0.0);
   VelocityGravityAlignment a;
-  std::vector<StampedPosition> two(d.positions.begin(), d.positions.begin() + 2);
+  std::vector<StampedPose> two(d.positions.begin(), d.positions.begin() + 2);
   EXPECT_EQ(AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), two, 0.01, &a)
                 .code(),
             Status::Code::kFailedPrecondition);
-  std::vector<StampedPosition> close(3, d.positions.front());
+  std::vector<StampedPose> close(3, d.positions.front());
   close[1].stamp_ns += 1'000'000;
   close[2].stamp_ns += 2'000'000;
   EXPECT_EQ(
@@ -154,7 +154,7 @@ TEST(InFlightAlignment, RefusesTooFewOrTooClosePositions) {
           .code(),
       Status::Code::kFailedPrecondition);
   // A position after the last IMU sample cannot be integrated.
-  std::vector<StampedPosition> late = d.positions;
+  std::vector<StampedPose> late = d.positions;
   late.back().stamp_ns = d.samples.back().stamp_ns + 1;
   EXPECT_EQ(
       AlignVelocityAndGravity(d.start, d.samples, 1.0, Eigen::Vector3d::Zero(), late, 0.01, &a)

@@ -48,8 +48,8 @@ struct Result {
 
 // The association options of the tests: a Mid-360's 0.15 deg, the rule's
 // drop threshold and projection as given (0 = off).
-AssociationOptions RuleOptions(double max_normal_stddev_rad, double tilt_projection_sigma) {
-  AssociationOptions options;
+ScanAssociationOptions RuleOptions(double max_normal_stddev_rad, double tilt_projection_sigma) {
+  ScanAssociationOptions options;
   options.plane.map_angular_stddev_deg = 0.15;
   options.max_normal_stddev_rad = max_normal_stddev_rad;
   options.tilt_projection_sigma = tilt_projection_sigma;
@@ -59,7 +59,7 @@ AssociationOptions RuleOptions(double max_normal_stddev_rad, double tilt_project
 // Map points observed from `map_range_m` (noise along each surface's normal
 // of range x 0.15 deg; the end walls from `end_wall_range_m`, 0 = the same),
 // a noise-free scan from (0, 0, 1.5).
-Result Associate(bool end_walls, double map_range_m, const AssociationOptions& options,
+Result Associate(bool end_walls, double map_range_m, const ScanAssociationOptions& options,
                  double end_wall_range_m = 0.0) {
   LocalMapOptions map_options;
   map_options.leaf_size_m = 0.3;

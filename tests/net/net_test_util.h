@@ -82,7 +82,7 @@ inline EgoStateMessage MakeRawEgoState(int sender, int num_observations, uint64_
   m.degenerated = (seed % 2) == 1;
   for (int i = 0, id = 0; i < num_observations; ++id) {
     if (id == sender) continue;
-    TeammateObservation o;
+    CurrentObservation o;
     o.observed_id = id;
     o.p_bk_in_bj = v.Vector32(20.0);
     o.cov_p_bk_in_bj = v.Covariance<3>(1e-3);

@@ -173,7 +173,7 @@ class ObserverSink : public sim::DroneSink {
       const sim::Pose bi = sim_.drones()[static_cast<size_t>(observer_)].trajectory.PoseAt(t);
       const Eigen::Vector3d p_bi_in_bj = s.R_W_b.transpose() * (bi.p_b_in_W - s.p_b_in_W);
       if (p_bi_in_bj.norm() < 6.0) {
-        net::TeammateObservation o;
+        net::CurrentObservation o;
         o.observed_id = observer_;
         std::normal_distribution<double> noise(0.0, 0.02);
         o.p_bk_in_bj = p_bi_in_bj + Eigen::Vector3d(noise(rng_), noise(rng_), noise(rng_));

@@ -222,7 +222,7 @@ int main(int argc, char** argv) {
   if (!eval::DeltaUnitFromString(FLAGS_delta_unit, &delta_unit)) {
     return Usage("--delta_unit '" + FLAGS_delta_unit + "' is not f or m");
   }
-  eval::AssociationOptions association;
+  eval::TrajectoryAssociationOptions association;
   association.max_time_diff_s = FLAGS_t_max_diff;
   association.time_offset_s = FLAGS_t_offset;
 

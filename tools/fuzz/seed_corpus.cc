@@ -35,7 +35,7 @@ net::EgoStateMessage EgoState(int sender, int num_observations, int num_past = 0
   m.degenerated = num_observations % 2 == 0;
   for (int id = 0; static_cast<int>(m.observations.size()) < num_observations; ++id) {
     if (id == sender) continue;
-    net::TeammateObservation o;
+    net::CurrentObservation o;
     o.observed_id = id;
     o.p_bk_in_bj = {2.0 + id, -1.0, 0.5 * id};
     o.cov_p_bk_in_bj = Covariance3(1e-3 * (1 + id));

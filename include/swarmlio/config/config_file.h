@@ -19,8 +19,8 @@
 #include <utility>
 #include <vector>
 
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/config/options_reader.h"
 #include "swarmlio/config/yaml_node.h"
 

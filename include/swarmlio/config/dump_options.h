@@ -16,7 +16,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::config {
 namespace internal {

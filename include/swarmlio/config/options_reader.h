@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/config/yaml_node.h"
 
 namespace swarmlio::config::internal {

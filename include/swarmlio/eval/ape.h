@@ -21,7 +21,7 @@ namespace swarmlio::eval {
 struct ApeOptions {
   PoseRelation relation = PoseRelation::kTranslation;
   Alignment alignment = Alignment::kNone;
-  AssociationOptions association;
+  TrajectoryAssociationOptions association;
 };
 
 struct ApeResult {

@@ -18,7 +18,8 @@
 
 namespace swarmlio::eval {
 
-struct AssociationOptions {
+/// Pairing of the poses of two trajectories by stamp (AssociateTrajectories).
+struct TrajectoryAssociationOptions {
   double max_time_diff_s = 0.01;  // evo's --t_max_diff default [s]
   double time_offset_s = 0.0;     // added to the estimate's stamps [s]
 };
@@ -39,7 +40,7 @@ struct AssociatedTrajectories {
 /// sizes without stamps, no pair within the tolerance.
 Status AssociateTrajectories(const Trajectory& reference,
                              const Trajectory& estimate,
-                             const AssociationOptions& options,
+                             const TrajectoryAssociationOptions& options,
                              AssociatedTrajectories* result);
 
 }  // namespace swarmlio::eval

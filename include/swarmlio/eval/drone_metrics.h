@@ -24,7 +24,7 @@
 namespace swarmlio::eval {
 
 struct DroneMetricsOptions {
-  AssociationOptions association;
+  TrajectoryAssociationOptions association;
   Alignment ape_alignment = Alignment::kSe3;
   double rpe_delta = 1.0;
   DeltaUnit rpe_delta_unit = DeltaUnit::kMeters;

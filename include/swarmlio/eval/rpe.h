@@ -52,7 +52,7 @@ struct RpeOptions {
   double all_pairs_relative_tolerance = 0.1;  // metres with all_pairs: |L - d| <= this x d
   Alignment alignment = Alignment::kNone;
   bool translation_in_world = false;  // step 3, world form; needs relation kTranslation
-  AssociationOptions association;
+  TrajectoryAssociationOptions association;
 };
 
 using IdPair = std::pair<size_t, size_t>;

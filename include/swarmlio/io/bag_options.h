@@ -1,6 +1,6 @@
 // Options of the ROS1 bag reader and writer (see docs/bag_format.md).
 //
-// Both structs follow config/option_fields.h: in-class defaults, one
+// Both structs follow common/option_fields.h: in-class defaults, one
 // VisitFields() that describes every field, and Validate() ("" when valid).
 #pragma once
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <utility>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/sensors/lidar_formats.h"
 
 namespace swarmlio::io {

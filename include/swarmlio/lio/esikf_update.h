@@ -46,7 +46,7 @@
 #include "factors/point_to_plane_factor.h"
 #include "factors/pose_information_factor.h"
 #include "swarmlio/lio/measurement_model.h"
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/state/swarm_state.h"
 

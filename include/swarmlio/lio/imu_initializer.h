@@ -28,8 +28,8 @@
 #include <string>
 #include <utility>
 
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/sensors/imu_options.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/swarm_state.h"

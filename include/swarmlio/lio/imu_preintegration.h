@@ -36,8 +36,8 @@
 #include <vector>
 
 #include "factors/imu_preintegration_factor.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/process_noise_options.h"
 #include "swarmlio/sensors/measurements.h"

@@ -26,8 +26,8 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/lio/process_noise_options.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/state_layout.h"

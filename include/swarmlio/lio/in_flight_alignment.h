@@ -31,7 +31,9 @@
 namespace swarmlio::lio {
 
 /// A pose of the body at a stamp, in G (a pass's posterior at a scan end).
-struct StampedPosition {
+/// The fit uses its position; the rotation re-anchors the integration. (Not
+/// PoseStamped of sensors/measurements.h, which carries a frame_id string.)
+struct StampedPose {
   int64_t stamp_ns = 0;
   Eigen::Vector3d p_b_in_G = Eigen::Vector3d::Zero();
   Eigen::Quaterniond q_G_b = Eigen::Quaterniond::Identity();
@@ -56,7 +58,7 @@ Status DoubleIntegrateSpecificForce(const ImuSample& start,
                                     const std::vector<ImuSample>& samples,
                                     double acceleration_to_m_s2,
                                     const Eigen::Vector3d& gyro_bias_rad_s,
-                                    const std::vector<StampedPosition>& poses,
+                                    const std::vector<StampedPose>& poses,
                                     std::vector<Eigen::Vector3d>* double_integrals);
 
 /// The least-squares v0 and g above. FailedPrecondition with fewer than 3
@@ -65,7 +67,7 @@ Status AlignVelocityAndGravity(const ImuSample& start,
                                const std::vector<ImuSample>& samples,
                                double acceleration_to_m_s2,
                                const Eigen::Vector3d& gyro_bias_rad_s,
-                               const std::vector<StampedPosition>& positions,
+                               const std::vector<StampedPose>& positions,
                                double position_stddev_floor_m,
                                VelocityGravityAlignment* result);
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/lio/esikf_update.h"
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
@@ -31,7 +31,7 @@ struct OdometryOptions {
   ImuPropagatorOptions propagation;
   PreprocessOptions preprocess;
   LocalMapOptions map;
-  AssociationOptions association;
+  ScanAssociationOptions association;
   EsikfUpdateOptions update;
   /// The window smoother (used when estimator is window).
   WindowOptions window;

@@ -37,7 +37,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/lio/map_neighbor.h"
 
 namespace swarmlio::lio {

@@ -33,7 +33,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/lio/voxel_filter.h"
 #include "swarmlio/sensors/lidar_options.h"
 #include "swarmlio/sensors/measurements.h"

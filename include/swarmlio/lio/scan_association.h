@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "factors/point_to_plane_factor.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/plane_fit.h"
 #include "swarmlio/state/swarm_state.h"
@@ -44,7 +44,9 @@ inline PlaneFitOptions AssociationPlaneFitDefaults() {
   return options;
 }
 
-struct AssociationOptions {
+/// Association of scan points to local-map planes (ScanAssociator); YAML section
+/// `odometry.experimental.association`.
+struct ScanAssociationOptions {
   int num_neighbors = 5;                 // k of the plane fit (NUM_MATCH_POINTS)
   // Effective sigma of z [m]: sensor noise plus map / plane-fit errors, which
   // are shared by neighbouring points (correlated), so far above the range
@@ -134,7 +136,7 @@ struct AssociationStats {
 class ScanAssociator {
  public:
   /// `map` must outlive the associator and not change while it is in use.
-  ScanAssociator(const LocalMap* map, const AssociationOptions& options);
+  ScanAssociator(const LocalMap* map, const ScanAssociationOptions& options);
 
   /// Starts a new scan: `points_in_b` (body frame at the scan end) must
   /// outlive the calls to Associate(). Forgets cached neighbours.
@@ -157,14 +159,14 @@ class ScanAssociator {
     Plane plane;
   };
 
-  // The noisy-plane rule (AssociationOptions: max_normal_stddev_rad, then
+  // The noisy-plane rule (ScanAssociationOptions: max_normal_stddev_rad, then
   // tilt_projection_sigma) on `out`, whose planes are planes_: drops and
   // shrinks along noise-dominated directions and counts both. Runs only while
   // max_normal_stddev_rad > 0 (which so switches the whole rule off).
   void ApplyNoisyPlaneRule(std::vector<PlaneCorrespondence>* out);
 
   const LocalMap* map_;
-  AssociationOptions options_;
+  ScanAssociationOptions options_;
   const std::vector<Eigen::Vector3d>* points_in_b_ = nullptr;
   std::vector<CachedPlane> cache_;
   std::vector<Neighbor> neighbors_;  // scratch

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::lio {
 

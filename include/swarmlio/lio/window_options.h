@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/window/marginalization.h"
 
 namespace swarmlio::lio {

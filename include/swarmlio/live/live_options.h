@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::live {
 

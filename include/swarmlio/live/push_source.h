@@ -56,7 +56,7 @@
 #include <tuple>
 #include <utility>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/live/record_source.h"
 #include "swarmlio/sensors/measurements.h"
 

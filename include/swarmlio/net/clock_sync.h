@@ -45,8 +45,8 @@
 #include <utility>
 #include <vector>
 
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/net/messages.h"
 
 namespace swarmlio::net {

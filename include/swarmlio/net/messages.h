@@ -27,8 +27,10 @@ enum class MessageType : uint8_t {
 
 const char* MessageTypeName(MessageType type);
 
-/// Sender j saw teammate k (LiDAR cluster of k's reflective tape).
-struct TeammateObservation {
+/// Sender j saw teammate k (LiDAR cluster of k's reflective tape) in the scan
+/// this message's state ends: the wire form of teammate::TeammateObservation
+/// in EgoStateMessage::observations (PastObservation: an earlier scan's).
+struct CurrentObservation {
   int observed_id = 0;                                   // k
   Eigen::Vector3d p_bk_in_bj = Eigen::Vector3d::Zero();  // k's body origin in j's body frame [m]
   Eigen::Matrix3d cov_p_bk_in_bj = Eigen::Matrix3d::Zero();  // its covariance [m^2]
@@ -103,8 +105,8 @@ struct EgoStateMessage {
   Eigen::Matrix3d cov_theta_Gj_bj = Eigen::Matrix3d::Zero();    // R = R^ Exp(dtheta) [rad^2]
   Eigen::Matrix3d cov_p_bj_in_Gj = Eigen::Matrix3d::Zero();     // [m^2]
   Eigen::Matrix3d cov_v_bj_in_Gj = Eigen::Matrix3d::Zero();     // [m^2/s^2]
-  bool degenerated = false;                       // j's last scan was LiDAR-degenerate
-  std::vector<TeammateObservation> observations;  // distinct ids, none == sender_id
+  bool degenerated = false;                        // j's last scan was LiDAR-degenerate
+  std::vector<CurrentObservation> observations;    // distinct ids, none == sender_id
   std::vector<PastObservation> past_observations;  // distinct ids, none == sender_id
   /// When the packet left j: stamp_ns + send_delay_ns (j's clock); -1 = not
   /// known. MessageChannel::Send sets it from its now_ns (wire version 5).

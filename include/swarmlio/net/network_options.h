@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/net/swarm_limits.h"
 
 namespace swarmlio::net {

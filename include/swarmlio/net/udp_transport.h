@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/net/transport.h"
 
 namespace swarmlio::net {

@@ -13,7 +13,7 @@
 #include <string>
 #include <utility>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio {
 

@@ -6,7 +6,7 @@
 #include <array>
 #include <utility>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio {
 

@@ -18,7 +18,7 @@
 #include <string>
 #include <utility>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/sensors/lidar_formats.h"
 
 namespace swarmlio {

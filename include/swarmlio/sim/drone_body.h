@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/sim/primitives.h"
 #include "swarmlio/sim/trajectory.h"
 

@@ -25,7 +25,7 @@
 #include <utility>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/sensors/lidar_options.h"
 #include "swarmlio/sim/imu_model.h"
 #include "swarmlio/sim/lidar_options.h"

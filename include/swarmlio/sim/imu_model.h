@@ -22,7 +22,7 @@
 #include <random>
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/sensors/imu_options.h"
 #include "swarmlio/sim/trajectory.h"
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/sensors/lidar_options.h"
 
 namespace swarmlio::sim {

@@ -12,7 +12,7 @@
 #include <random>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/sim/trajectory.h"
 
 namespace swarmlio::sim {

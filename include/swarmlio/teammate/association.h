@@ -8,13 +8,14 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::teammate {
 
-/// YAML section `teammate.association`. Defaults: Swarm-LIO2 (field reference
+/// Association of clusters to tracker predictions; YAML section
+/// `teammate.experimental.association`. Defaults: Swarm-LIO2 (field reference
 /// 1.2, 1.4; simulation.yaml where it differs from the code).
-struct AssociationOptions {
+struct TrackAssociationOptions {
   double teammate_gate_m = 0.3;            // valid_cluster_dist_thresh (0.2 Mid-360 .. 0.6 sim)
   double temporary_gate_m = 0.8;           // valid_temp_cluster_dist_thresh (0.4; 0.8 in sim)
   bool recluster_in_predicted_region = true;  // cluster_extraction_in_predict_region

@@ -11,7 +11,7 @@
 #include <Eigen/Core>
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::teammate {
 

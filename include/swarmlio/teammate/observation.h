@@ -34,7 +34,7 @@
 #include <Eigen/Core>
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/teammate/scan_types.h"
 
 namespace swarmlio::teammate {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/teammate/scan_types.h"
 
 namespace swarmlio::teammate {

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/teammate/association.h"
 #include "swarmlio/teammate/clustering.h"
 #include "swarmlio/teammate/observation.h"
@@ -19,7 +19,7 @@ namespace swarmlio::teammate {
 
 struct TeammateDetectorOptions {
   ClusteringOptions clustering;
-  AssociationOptions association;
+  TrackAssociationOptions association;
   TemporaryTrackerOptions temporary;
   ExcitationOptions excitation;
   MatchingOptions matching;

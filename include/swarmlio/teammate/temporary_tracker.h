@@ -7,7 +7,7 @@
 #include <Eigen/Core>
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/teammate/cv_filter.h"
 #include "swarmlio/teammate/trajectory_buffer.h"
 

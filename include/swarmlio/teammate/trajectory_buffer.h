@@ -16,7 +16,7 @@
 #include <deque>
 #include <string>
 
-#include "swarmlio/config/option_fields.h"
+#include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::teammate {
 

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 #include "swarmlio/teammate/odometry_history.h"
 #include "swarmlio/teammate/trajectory_buffer.h"
 

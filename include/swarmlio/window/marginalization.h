@@ -42,8 +42,8 @@
 #include <vector>
 
 #include "factors/marginalization_prior_factor.h"
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/config/option_fields.h"
 
 namespace swarmlio {
 

@@ -1,4 +1,5 @@
-// Appends little-endian integers and IEEE floats to a byte buffer (no padding).
+// Appends little-endian integers and IEEE floats to a byte buffer (no padding):
+// the encoding side of PacketReader (packet_reader.h).
 #pragma once
 
 #include <cstdint>
@@ -7,9 +8,9 @@
 
 namespace swarmlio::net::internal {
 
-class WireWriter {
+class PacketWriter {
  public:
-  explicit WireWriter(std::vector<uint8_t>* out) : out_(out) {}
+  explicit PacketWriter(std::vector<uint8_t>* out) : out_(out) {}
 
   void U8(uint8_t value) { out_->push_back(value); }
   void U16(uint16_t value) { PutLittleEndian(value, 2); }

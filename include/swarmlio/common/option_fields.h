@@ -53,6 +53,11 @@
 // config/dump_options.h.
 //
 // Default-constructed options are pure values: nothing here touches files.
+//
+// Header-only, in common/ because every module's options include it (no
+// module links swarmlio_config for it). Its names stay in namespace
+// swarmlio::config, spelt config::FieldSpec, config::ValidateFields, ... in
+// every module, next to config::ConfigFile and config::DumpOptions.
 #pragma once
 
 #include <Eigen/Core>

@@ -4,6 +4,17 @@
 // rejects NaN and Inf, so a decoder built on it cannot overrun its buffer or
 // let a non-finite value into the estimator. Errors are DataLoss Status values
 // naming the field and the offset.
+//
+// Not merged with io's RosMessageReader (src/io/ros_message_reader.h), though
+// both are bounds-checked little-endian readers: the two check different
+// things. This one validates values (floats finite, Invalid() for the range
+// checks of decoded codes, field names with an index) because a decoded packet
+// goes straight into the estimator. ROS messages legitimately carry NaN (the
+// invalid points of a PointCloud2, which the record checks drop one by one),
+// so that reader returns values as read and checks length prefixes before
+// allocating instead. Their error texts differ too ("truncated reading field"
+// here, "message truncated reading field" there). One class would need a
+// switch for both, and would offer the packet decoders unchecked float reads.
 #pragma once
 
 #include <cmath>
@@ -17,9 +28,9 @@
 
 namespace swarmlio::net::internal {
 
-class WireReader {
+class PacketReader {
  public:
-  WireReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+  PacketReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
 
   size_t position() const { return position_; }
   size_t remaining() const { return size_ - position_; }

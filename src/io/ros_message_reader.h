@@ -4,6 +4,11 @@
 // read from the wire is checked against the remaining bytes before anything
 // is allocated, so a corrupt length can neither overrun the buffer nor trigger
 // a huge allocation. Errors are DataLoss Status values naming the field.
+// Floats are returned as read, NaN included: a scan's NaN points are dropped
+// one by one by the record checks (docs/bag_format.md), not the whole
+// message. Also parses bag record headers (u32-length-prefixed fields, the
+// same encoding). Swarm packets have their own reader, which also checks
+// values: net's PacketReader (src/net/packet_reader.h says why there are two).
 #pragma once
 
 #include <cstddef>
@@ -39,9 +44,9 @@ inline double LoadFloat64(const uint8_t* bytes) {
   return value;
 }
 
-class WireReader {
+class RosMessageReader {
  public:
-  WireReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+  RosMessageReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
 
   size_t position() const { return position_; }
   size_t remaining() const { return size_ - position_; }

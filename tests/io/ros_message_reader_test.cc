@@ -1,4 +1,4 @@
-#include "src/io/wire_reader.h"
+#include "src/io/ros_message_reader.h"
 
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 namespace swarmlio::io::internal {
 namespace {
 
-TEST(WireReaderTest, ReadsLittleEndianScalars) {
+TEST(RosMessageReaderTest, ReadsLittleEndianScalars) {
   const std::vector<uint8_t> bytes = {0x01, 0x78, 0x56, 0x34, 0x12, 0x08, 0x07, 0x06, 0x05,
                                       0x04, 0x03, 0x02, 0x01, 0x00, 0x00, 0x80, 0x3f};
-  WireReader reader(bytes.data(), bytes.size());
+  RosMessageReader reader(bytes.data(), bytes.size());
   uint8_t u8 = 0;
   uint32_t u32 = 0;
   uint64_t u64 = 0;
@@ -28,9 +28,9 @@ TEST(WireReaderTest, ReadsLittleEndianScalars) {
   EXPECT_TRUE(reader.ExpectEnd("m").ok());
 }
 
-TEST(WireReaderTest, TruncatedReadIsDataLossNamingTheField) {
+TEST(RosMessageReaderTest, TruncatedReadIsDataLossNamingTheField) {
   const std::vector<uint8_t> bytes = {1, 2, 3};
-  WireReader reader(bytes.data(), bytes.size());
+  RosMessageReader reader(bytes.data(), bytes.size());
   uint32_t value = 0;
   const Status status = reader.ReadU32("header.seq", &value);
   EXPECT_EQ(status.code(), Status::Code::kDataLoss);
@@ -38,34 +38,34 @@ TEST(WireReaderTest, TruncatedReadIsDataLossNamingTheField) {
   EXPECT_EQ(reader.position(), 0u);
 }
 
-TEST(WireReaderTest, LyingArrayLengthIsRejectedBeforeAllocation) {
+TEST(RosMessageReaderTest, LyingArrayLengthIsRejectedBeforeAllocation) {
   // Length 0xFFFFFFFF followed by 4 bytes.
   const std::vector<uint8_t> bytes = {0xff, 0xff, 0xff, 0xff, 1, 2, 3, 4};
-  WireReader reader(bytes.data(), bytes.size());
+  RosMessageReader reader(bytes.data(), bytes.size());
   std::string text;
   EXPECT_EQ(reader.ReadString("frame_id", &text).code(), Status::Code::kDataLoss);
-  WireReader reader2(bytes.data(), bytes.size());
+  RosMessageReader reader2(bytes.data(), bytes.size());
   uint32_t length = 0;
   EXPECT_FALSE(reader2.ReadArrayLength("points", 19, &length).ok());
   // 0 elements of any size is fine.
   const std::vector<uint8_t> empty = {0, 0, 0, 0};
-  WireReader reader3(empty.data(), empty.size());
+  RosMessageReader reader3(empty.data(), empty.size());
   EXPECT_TRUE(reader3.ReadArrayLength("points", 19, &length).ok());
   EXPECT_EQ(length, 0u);
 }
 
-TEST(WireReaderTest, ArrayLengthOverflowIsRejected) {
+TEST(RosMessageReaderTest, ArrayLengthOverflowIsRejected) {
   // 0x40000000 elements * 8 bytes overflows 32 bits; must still be rejected.
   std::vector<uint8_t> bytes = {0x00, 0x00, 0x00, 0x40};
   bytes.resize(64, 0);
-  WireReader reader(bytes.data(), bytes.size());
+  RosMessageReader reader(bytes.data(), bytes.size());
   uint32_t length = 0;
   EXPECT_FALSE(reader.ReadArrayLength("data", 8, &length).ok());
 }
 
-TEST(WireReaderTest, TrailingBytesAreReported) {
+TEST(RosMessageReaderTest, TrailingBytesAreReported) {
   const std::vector<uint8_t> bytes = {1, 2};
-  WireReader reader(bytes.data(), bytes.size());
+  RosMessageReader reader(bytes.data(), bytes.size());
   uint8_t value = 0;
   ASSERT_TRUE(reader.ReadU8("a", &value).ok());
   EXPECT_EQ(reader.ExpectEnd("m").code(), Status::Code::kDataLoss);
