@@ -87,7 +87,7 @@ class FloorWindow {
     }
     WindowOptions options;
     options.size = size;
-    AssociationOptions association;
+    ScanAssociationOptions association;
     association.max_normal_stddev_rad = 0.0;  // a floor: no noisy-plane handling
     association.tilt_projection_sigma = 0.0;
     status_ = WindowSmoother::Create(options, ImuPropagatorOptions(), association,
