@@ -9,7 +9,8 @@
 # Scenarios: indoor_3uav, wall_degenerate, corridor (first 45 s) and swarm_40
 # (first 25 s), each swarm and single-agent, filter and window K = 5 (swarm_40
 # filter only), simulated once with the new build's simulator. Exit 1 on any
-# difference. About 30 minutes on 2 cores.
+# difference. About 30 minutes on 2 cores. With REUSE_OLD=1 the old side's
+# outputs already in OUT are kept (one baseline run shared by several checks).
 set -euo pipefail
 OLD="${1:?old build dir}"
 NEW="${2:?new build dir}"
@@ -34,6 +35,7 @@ for scn in indoor_3uav wall_degenerate corridor swarm_40; do
       for side in old new; do
         dir="$OUT/$side/$scn/$mode-$est"
         bin="$OLD"; [[ $side == new ]] && bin="$NEW"
+        [[ $side == old && ${REUSE_OLD:-0} == 1 && -f $dir/log.txt ]] && continue
         mkdir -p "$dir"
         "$bin/tools/replay/swarmlio_replay" "${args[@]}" --output_dir "$dir" > "$dir/log.txt" 2>&1
       done
