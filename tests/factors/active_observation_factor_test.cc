@@ -14,36 +14,12 @@
 #include "factors/global_extrinsic_manifold.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
-#include "test_utils/random_sampler.h"
+#include "test_utils/state_sampler.h"
 
 namespace swarmlio {
 namespace {
 
-class Sampler : public swarmlio::testing::RandomSampler {
- public:
-  using RandomSampler::RandomSampler;
-  EgoState Ego(double angle) {
-    EgoState ego;
-    ego.q_G_b = Rotation(angle);
-    ego.p_b_in_G = Gaussian3(5.0);
-    ego.v_b_in_G = Gaussian3(1.0);
-    ego.gyro_bias = Gaussian3(0.01);
-    ego.accel_bias = Gaussian3(0.1);
-    return ego;
-  }
-  GlobalExtrinsic Extrinsic(double angle) {
-    GlobalExtrinsic T;
-    T.q_Gi_Gj = Rotation(angle);
-    T.p_Gj_in_Gi = Gaussian3(10.0);
-    return T;
-  }
-  // A random SPD covariance with eigenvalues roughly in [floor, floor + scale^2 * 9].
-  Eigen::Matrix3d Covariance(double scale, double floor) {
-    Eigen::Matrix3d A;
-    for (int i = 0; i < 9; ++i) A.data()[i] = scale * Normal();
-    return A * A.transpose() + floor * Eigen::Matrix3d::Identity();
-  }
-};
+using Sampler = swarmlio::testing::StateSampler;
 
 // The definition, written independently of the factor.
 Eigen::Vector3d ActivePrediction(const EgoState& ego,
@@ -68,8 +44,8 @@ struct Problem {
     p_bj_in_Gj = s->Gaussian3(8.0);
     z = ActivePrediction(ego, extrinsic, p_bj_in_Gj);
     if (!exact_measurement) z += s->Gaussian3(0.3);
-    Sigma_obs = s->Covariance(0.1, 1e-3);
-    Sigma_p = s->Covariance(0.1, 1e-3);
+    Sigma_obs = s->Covariance3(0.1, 1e-3);
+    Sigma_p = s->Covariance3(0.1, 1e-3);
     R_Gi_bi_lin = ego.R_G_b() * so3::Exp(s->Gaussian3(0.02));
     R_Gi_Gj_lin = extrinsic.R_Gi_Gj() * so3::Exp(s->Gaussian3(0.02));
   }

@@ -14,36 +14,12 @@
 #include "factors/global_extrinsic_manifold.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
-#include "test_utils/random_sampler.h"
+#include "test_utils/state_sampler.h"
 
 namespace swarmlio {
 namespace {
 
-class Sampler : public swarmlio::testing::RandomSampler {
- public:
-  using RandomSampler::RandomSampler;
-  EgoState Ego(double angle) {
-    EgoState ego;
-    ego.q_G_b = Rotation(angle);
-    ego.p_b_in_G = Gaussian3(5.0);
-    ego.v_b_in_G = Gaussian3(1.0);
-    ego.gyro_bias = Gaussian3(0.01);
-    ego.accel_bias = Gaussian3(0.1);
-    ego.g_in_G = 9.81 * Gaussian3(1.0).normalized();
-    return ego;
-  }
-  GlobalExtrinsic Extrinsic(double angle) {
-    GlobalExtrinsic T;
-    T.q_Gi_Gj = Rotation(angle);
-    T.p_Gj_in_Gi = Gaussian3(10.0);
-    return T;
-  }
-  Eigen::Matrix3d Covariance(double scale, double floor) {
-    Eigen::Matrix3d A;
-    for (int i = 0; i < 9; ++i) A.data()[i] = scale * Normal();
-    return A * A.transpose() + floor * Eigen::Matrix3d::Identity();
-  }
-};
+using Sampler = swarmlio::testing::StateSampler;
 
 struct Problem {
   EgoState ego;
@@ -57,7 +33,7 @@ struct Problem {
       : ego(s->Ego(ego_angle)), extrinsic(s->Extrinsic(ext_angle)) {
     g_in_Gj = extrinsic.R_Gi_Gj().transpose() * ego.g_in_G;
     if (!exact) g_in_Gj += s->Gaussian3(0.05);
-    Sigma_g = s->Covariance(0.01, 1e-5);
+    Sigma_g = s->Covariance3(0.01, 1e-5);
     R_lin = extrinsic.R_Gi_Gj() * so3::Exp(s->Gaussian3(0.02));
   }
   GravityAlignmentFactor Factor() const {

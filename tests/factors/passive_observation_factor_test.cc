@@ -15,36 +15,12 @@
 #include "factors/global_extrinsic_manifold.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
-#include "test_utils/random_sampler.h"
+#include "test_utils/state_sampler.h"
 
 namespace swarmlio {
 namespace {
 
-class Sampler : public swarmlio::testing::RandomSampler {
- public:
-  using RandomSampler::RandomSampler;
-  EgoState Ego(double angle) {
-    EgoState ego;
-    ego.q_G_b = Rotation(angle);
-    ego.p_b_in_G = Gaussian3(5.0);
-    ego.v_b_in_G = Gaussian3(2.0);
-    ego.gyro_bias = Gaussian3(0.01);
-    ego.accel_bias = Gaussian3(0.1);
-    return ego;
-  }
-  GlobalExtrinsic Extrinsic(double angle) {
-    GlobalExtrinsic T;
-    T.q_Gi_Gj = Rotation(angle);
-    T.p_Gj_in_Gi = Gaussian3(10.0);
-    return T;
-  }
-  // A random SPD covariance with eigenvalues roughly in [floor, floor + scale^2 * 9].
-  Eigen::Matrix3d Covariance(double scale, double floor) {
-    Eigen::Matrix3d A;
-    for (int i = 0; i < 9; ++i) A.data()[i] = scale * Normal();
-    return A * A.transpose() + floor * Eigen::Matrix3d::Identity();
-  }
-};
+using Sampler = swarmlio::testing::StateSampler;
 
 // The IMU part of the ego's motion back to t_j, written from its definition:
 // A = R (u + M (b_a0 - b_a)) + W g with u, M formed at the linearization
@@ -102,9 +78,9 @@ struct Problem {
     p_bj_in_Gj = s->Gaussian3(8.0);
     z = PassivePrediction(ego, extrinsic, dt, R_Gj_bj, p_bj_in_Gj, r, ego_lin);
     if (!exact_measurement) z += s->Gaussian3(0.3);
-    Sigma_obs = s->Covariance(0.1, 1e-3);
-    Sigma_theta = s->Covariance(0.01, 1e-6);
-    Sigma_p = s->Covariance(0.1, 1e-3);
+    Sigma_obs = s->Covariance3(0.1, 1e-3);
+    Sigma_theta = s->Covariance3(0.01, 1e-6);
+    Sigma_p = s->Covariance3(0.1, 1e-3);
   }
   PassiveObservationFactor Factor() const {
     return PassiveObservationFactor(z, dt, R_Gj_bj, p_bj_in_Gj, Sigma_obs, Sigma_theta, Sigma_p,

@@ -12,21 +12,14 @@
 #include "factors/ego_state_manifold.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
-#include "test_utils/random_sampler.h"
+#include "test_utils/state_sampler.h"
 
 namespace swarmlio {
 namespace {
 
-class Sampler : public swarmlio::testing::RandomSampler {
+class Sampler : public swarmlio::testing::StateSampler {
  public:
-  using RandomSampler::RandomSampler;
-  EgoState Ego(double angle) {
-    EgoState ego;
-    ego.q_G_b = Rotation(angle);
-    ego.p_b_in_G = Gaussian3(5.0);
-    ego.v_b_in_G = Gaussian3(1.0);
-    return ego;
-  }
+  using StateSampler::StateSampler;
   // Correspondences built from explicit plane points q_n (eq. (4) form).
   std::vector<PlaneCorrespondence> Correspondences(int n, std::vector<Eigen::Vector3d>* q) {
     std::vector<PlaneCorrespondence> out(n);

@@ -14,51 +14,12 @@
 #include "factors/global_extrinsic_manifold.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
+#include "test_utils/state_sampler.h"
 
 namespace swarmlio {
 namespace {
 
-class Sampler {
- public:
-  explicit Sampler(unsigned seed) : rng_(seed) {}
-  double Normal() { return n_(rng_); }
-  Eigen::VectorXd Gaussian(int n, double scale) {
-    Eigen::VectorXd v(n);
-    for (int i = 0; i < n; ++i) v[i] = scale * Normal();
-    return v;
-  }
-  Eigen::Vector3d Axis() { return Eigen::Vector3d(Gaussian(3, 1.0)).normalized(); }
-  // Rotation by `angle` about a random axis (uniformly random when < 0).
-  Eigen::Quaterniond Rotation(double angle) {
-    if (angle < 0) return Eigen::Quaterniond(Eigen::Vector4d(Gaussian(4, 1.0)).normalized());
-    return so3::ExpQuaternion(Axis() * angle);
-  }
-  SwarmState State(int num_teammates, double angle) {
-    SwarmState x;
-    x.ego.q_G_b = Rotation(angle);
-    x.ego.p_b_in_G = Gaussian(3, 5.0);
-    x.ego.v_b_in_G = Gaussian(3, 1.0);
-    x.ego.gyro_bias = Gaussian(3, 0.01);
-    x.ego.accel_bias = Gaussian(3, 0.1);
-    x.ego.g_in_G = Gaussian(3, 9.81 / std::sqrt(3.0));
-    for (int j = 0; j < num_teammates; ++j) {
-      GlobalExtrinsic T;
-      T.q_Gi_Gj = Rotation(angle);
-      T.p_Gj_in_Gi = Gaussian(3, 10.0);
-      x.AddTeammate(3 + 4 * j, T);  // ids need not be slots
-    }
-    return x;
-  }
-  Eigen::MatrixXd Covariance(int n) {
-    const Eigen::VectorXd a = Gaussian(n * n, 0.3);
-    const Eigen::MatrixXd A = Eigen::Map<const Eigen::MatrixXd>(a.data(), n, n);
-    return A * A.transpose() + 0.05 * Eigen::MatrixXd::Identity(n, n);
-  }
-
- private:
-  std::mt19937 rng_;
-  std::normal_distribution<double> n_;
-};
+using Sampler = swarmlio::testing::StateSampler;
 
 // Ceres parameter storage of a state plus the matching manifolds.
 struct Blocks {
@@ -90,7 +51,7 @@ std::unique_ptr<PriorFactor> MakePrior(const SwarmState& x_hat, const Eigen::Mat
 TEST(PriorFactor, BlockSizesFollowTheLayout) {
   Sampler s(1);
   const SwarmState x_hat = s.State(2, -1.0);
-  const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim()));
+  const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim(), 0.3, 0.05));
   EXPECT_EQ(prior->num_residuals(), 30);
   EXPECT_EQ(prior->parameter_block_sizes(), (std::vector<int32_t>{19, 7, 7}));
 }
@@ -98,7 +59,7 @@ TEST(PriorFactor, BlockSizesFollowTheLayout) {
 TEST(PriorFactor, ResidualIsWhitenedBoxMinus) {
   Sampler s(2);
   const SwarmState x_hat = s.State(2, -1.0);
-  const Eigen::MatrixXd P = s.Covariance(x_hat.Dim());
+  const Eigen::MatrixXd P = s.Covariance(x_hat.Dim(), 0.3, 0.05);
   const auto prior = MakePrior(x_hat, P);
   const SwarmState x = x_hat.BoxPlus(s.Gaussian(x_hat.Dim(), 0.5));
   const Eigen::VectorXd e = x.BoxMinus(x_hat);
@@ -115,7 +76,7 @@ TEST(PriorFactor, ResidualIsWhitenedBoxMinus) {
 TEST(PriorFactor, BoxMinusJacobianIsRightJacobianInverse) {
   Sampler s(3);
   const SwarmState x_hat = s.State(2, -1.0);
-  const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim()));
+  const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim(), 0.3, 0.05));
   const SwarmState x = x_hat.BoxPlus(s.Gaussian(x_hat.Dim(), 0.7));
   const auto f = [&](const Eigen::VectorXd& d) -> Eigen::VectorXd {
     return x.BoxPlus(d).BoxMinus(x_hat);
@@ -129,7 +90,7 @@ TEST(PriorFactor, TangentJacobianMatchesNumericBoxPlus) {
   Sampler s(8);
   for (int trial = 0; trial < 5; ++trial) {
     const SwarmState x_hat = s.State(2, -1.0);
-    const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim()));
+    const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim(), 0.3, 0.05));
     const SwarmState x = x_hat.BoxPlus(s.Gaussian(x_hat.Dim(), 0.5));
     const auto f = [&](const Eigen::VectorXd& d) -> Eigen::VectorXd {
       return prior->Residual(x.BoxPlus(d));
@@ -175,7 +136,7 @@ TEST(PriorFactor, JacobiansAreCorrectWithTeammates) {
     for (int trial = 0; trial < 12; ++trial) {
       const int num_teammates = trial % 3;
       const SwarmState x_hat = s.State(num_teammates, regime.state_angle);
-      const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim()));
+      const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim(), 0.3, 0.05));
       const SwarmState x = Perturb(&s, x_hat, regime.error_angle, regime.error_scale);
       Blocks blocks(x);
       EXPECT_TRUE(
@@ -192,7 +153,7 @@ TEST(PriorFactor, JacobianAtXHatAndNearPiDifference) {
   for (double error_angle : {0.0, 1e-3, 0.7, 2.5, 2.8, 3.0, M_PI - 0.04}) {
     SCOPED_TRACE(error_angle);
     const SwarmState x_hat = s.State(2, -1.0);
-    const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim()));
+    const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim(), 0.3, 0.05));
     const SwarmState x = Perturb(&s, x_hat, error_angle, error_angle > 0 ? 0.3 : 0.0);
     Blocks blocks(x);
     const int n = x.Dim();
@@ -219,7 +180,7 @@ TEST(PriorFactor, JacobianAtXHatAndNearPiDifference) {
 TEST(PriorFactor, FlippedSignIsRejected) {
   Sampler s(6);
   const SwarmState x_hat = s.State(2, -1.0);
-  const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim()));
+  const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim(), 0.3, 0.05));
   const SwarmState x = x_hat.BoxPlus(s.Gaussian(x_hat.Dim(), 0.5));
   Blocks blocks(x);
   const testing::FlippedJacobianColumns flipped(prior.get(), /*block=*/0, /*num_columns=*/4);
@@ -230,7 +191,7 @@ TEST(PriorFactor, FlippedSignIsRejected) {
 TEST(PriorFactor, HonoursNullJacobianPerBlock) {
   Sampler s(7);
   const SwarmState x_hat = s.State(2, -1.0);
-  const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim()));
+  const auto prior = MakePrior(x_hat, s.Covariance(x_hat.Dim(), 0.3, 0.05));
   const SwarmState x = x_hat.BoxPlus(s.Gaussian(x_hat.Dim(), 0.5));
   Blocks blocks(x);
   const int n = x.Dim();

@@ -15,32 +15,14 @@
 #include "factors/ego_state_manifold.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
-#include "test_utils/random_sampler.h"
+#include "test_utils/state_sampler.h"
 
 namespace swarmlio {
 namespace {
 
 using Matrix6 = RelativePoseFactor::Matrix6;
 
-class Sampler : public swarmlio::testing::RandomSampler {
- public:
-  using RandomSampler::RandomSampler;
-  EgoState Ego(double angle) {
-    EgoState ego;
-    ego.q_G_b = Rotation(angle);
-    ego.p_b_in_G = Gaussian3(5.0);
-    ego.v_b_in_G = Gaussian3(1.0);
-    ego.gyro_bias = Gaussian3(0.01);
-    ego.accel_bias = Gaussian3(0.1);
-    ego.g_in_G = 9.81 * Gaussian3(1.0).normalized();
-    return ego;
-  }
-  Matrix6 Covariance() {
-    Matrix6 A;
-    for (int i = 0; i < 36; ++i) A.data()[i] = 0.05 * Normal();
-    return A * A.transpose() + 1e-3 * Matrix6::Identity();
-  }
-};
+using Sampler = swarmlio::testing::StateSampler;
 
 Eigen::Isometry3d Pose(const EgoState& ego) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -58,7 +40,7 @@ struct Problem {
   Matrix6 covariance;
 
   Problem(Sampler* s, double angle_a, double angle_b, double error_rad, double error_m)
-      : a(s->Ego(angle_a)), b(s->Ego(angle_b)), covariance(s->Covariance()) {
+      : a(s->Ego(angle_a)), b(s->Ego(angle_b)), covariance(s->Covariance(6, 0.05, 1e-3)) {
     const Eigen::Isometry3d T_a_b = Pose(a).inverse() * Pose(b);
     T_a_b_measured = T_a_b;
     T_a_b_measured.linear() = T_a_b.linear() * so3::Exp(s->Gaussian3(error_rad));
@@ -173,7 +155,7 @@ TEST(RelativePoseFactor, TangentJacobianIsTheStatedFormulaAndNumeric) {
 
 TEST(RelativePoseFactor, SqrtInformationWhitensTheCovariance) {
   Sampler s(5);
-  const Matrix6 C = s.Covariance();
+  const Matrix6 C = s.Covariance(6, 0.05, 1e-3);
   const Matrix6 L = RelativePoseFactor::SqrtInformationOfCovariance(C);
   EXPECT_TRUE(testing::MatricesNear(L * C * L.transpose(), Matrix6::Identity(), 1e-9, 1e-9));
   EXPECT_TRUE(testing::MatricesNear(L.transpose() * L, Matrix6(C.inverse()), 1e-6, 1e-9));
