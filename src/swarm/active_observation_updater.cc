@@ -3,6 +3,8 @@
 #include <cmath>
 #include <memory>
 
+#include "swarmlio/common/time.h"
+
 #include "factors/active_observation_factor.h"
 #include "observation_terms.h"
 
@@ -25,7 +27,7 @@ void ActiveObservationUpdater::AddTerms(const UpdaterScan& scan, ObservationGate
       ++report->skipped_degenerate;
       continue;
     }
-    const double age = Seconds(scan.t_k - m.stamp_ns);
+    const double age = ToSeconds(scan.t_k - m.stamp_ns);
     if (std::abs(age) > so.max_message_age_s) {
       ++report->rejected;
       ++counters_->observations_rejected;

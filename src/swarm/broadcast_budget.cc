@@ -1,4 +1,5 @@
 // swarm::BroadcastBudget and swarm::SendRotation (broadcast_budget.h).
+#include "swarmlio/common/time.h"
 #include "swarmlio/swarm/broadcast_budget.h"
 
 #include <algorithm>
@@ -16,7 +17,7 @@ void BroadcastBudget::Refill(int64_t stamp_ns) {
   if (!refilled_) {
     credit_ = capacity;
   } else if (stamp_ns > last_stamp_ns_) {
-    credit_ += options_.max_bytes_per_s * static_cast<double>(stamp_ns - last_stamp_ns_) * 1e-9;
+    credit_ += options_.max_bytes_per_s * SecondsBetween(last_stamp_ns_, stamp_ns);
     credit_ = std::min(credit_, capacity);
   }
   if (!refilled_ || stamp_ns > last_stamp_ns_) last_stamp_ns_ = stamp_ns;

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "broadcaster.h"
+#include "swarmlio/common/time.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/net/wire_format.h"
 
@@ -195,7 +196,7 @@ void Broadcaster::ChooseNewExtrinsics(Pass* pass) {
           !extrinsic_rotation_.EverSent(id) ||
           (overdue_s > 0.0 &&
            extrinsic_rotation_.LastSentNs(id) != std::numeric_limits<int64_t>::min() &&
-           Seconds(t_k - extrinsic_rotation_.LastSentNs(id)) >= overdue_s);
+           ToSeconds(t_k - extrinsic_rotation_.LastSentNs(id)) >= overdue_s);
       (urgent ? fresh : pass->sent_before).push_back(id);
     }
     fresh = extrinsic_rotation_.Order(std::move(fresh));
@@ -295,7 +296,7 @@ void Broadcaster::SendExtrinsics(Pass* pass) {
   const int max_entries = options_.broadcast_budget.max_extrinsic_entries_per_broadcast;
   std::vector<int>& entry_ids = pass->entry_ids;
   const bool due = period > 0.0 && (!broadcast_extrinsics_once_ ||
-                                    Seconds(t_k - last_extrinsic_broadcast_ns_) >= period);
+                                    ToSeconds(t_k - last_extrinsic_broadcast_ns_) >= period);
   if (due && !pass->blocked) {
     const size_t before = entry_ids.size();
     ChooseExtrinsicEntries(extrinsic_rotation_.Order(std::move(pass->sent_before)), max_entries,

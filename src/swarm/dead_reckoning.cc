@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "swarmlio/common/time.h"
+
 namespace swarmlio::swarm::internal {
 
 void DeadReckoningTrack::Append(const std::vector<ImuPose>& poses, double keep_s) {
@@ -24,7 +26,7 @@ void DeadReckoningTrack::Append(const std::vector<ImuPose>& poses, double keep_s
         {poses[k].stamp_ns, poses[k + 1].stamp_ns, poses[k].acc_in_G_m_s2, poses[k].R_G_b});
   }
   if (segments_.empty()) return;
-  const int64_t keep_ns = static_cast<int64_t>(keep_s * 1e9);
+  const int64_t keep_ns = ToNanoseconds(keep_s);
   const int64_t newest = segments_.back().end_ns;
   while (segments_.size() > 1 && segments_.front().end_ns < newest - keep_ns) {
     segments_.pop_front();
@@ -43,8 +45,8 @@ bool DeadReckoningTrack::Retrodiction(int64_t t_j_ns, int64_t t_k_ns,
   ImuRetrodiction sum;
   for (; it != segments_.end() && it->begin_ns < t_k_ns; ++it) {
     // int_a^b (s - t_j) ds over the part of the segment inside [t_j, t_k].
-    const double a = 1e-9 * static_cast<double>(std::max(it->begin_ns, t_j_ns) - t_j_ns);
-    const double b = 1e-9 * static_cast<double>(std::min(it->end_ns, t_k_ns) - t_j_ns);
+    const double a = SecondsBetween(t_j_ns, std::max(it->begin_ns, t_j_ns));
+    const double b = SecondsBetween(t_j_ns, std::min(it->end_ns, t_k_ns));
     const double w = 0.5 * (b * b - a * a);
     sum.weight_s2 += w;
     sum.weighted_acc_in_G += w * it->acc_in_G;

@@ -2,17 +2,19 @@
 
 #include <algorithm>
 
+#include "swarmlio/common/time.h"
+
 #include "teammate_state.h"
 
 namespace swarmlio::swarm::internal {
 Status DetectorInput::Make(const LidarScan& raw, int64_t t_k, const std::vector<ImuPose>& poses,
                            const SwarmState& x, const teammate::ScanResult& last_detection,
-                           double last_detection_s, std::vector<teammate::ScanPoint>* points) {
+                           int64_t last_detection_ns, std::vector<teammate::ScanPoint>* points) {
   const Eigen::Matrix3d R_imu_lidar = lidar_.QuaternionImuLidar().toRotationMatrix();
-  Select(raw, t_k, x, last_detection, last_detection_s, R_imu_lidar);
+  Select(raw, t_k, x, last_detection, last_detection_ns, R_imu_lidar);
   SWARMLIO_RETURN_IF_ERROR(
       UndistortScan(selected_, poses, R_imu_lidar, lidar_.p_lidar_in_imu_m, &undistorted_));
-  const double end_offset_s = Seconds(t_k - raw.stamp_ns);
+  const double end_offset_s = ToSeconds(t_k - raw.stamp_ns);
   points->resize(undistorted_.size());
   for (size_t k = 0; k < undistorted_.size(); ++k) {
     const UndistortedPoint& u = undistorted_[k];
@@ -25,7 +27,7 @@ Status DetectorInput::Make(const LidarScan& raw, int64_t t_k, const std::vector<
 }
 
 void DetectorInput::Select(const LidarScan& raw, int64_t t_k, const SwarmState& x,
-                           const teammate::ScanResult& last_detection, double last_detection_s,
+                           const teammate::ScanResult& last_detection, int64_t last_detection_ns,
                            const Eigen::Matrix3d& R_imu_lidar) {
   const teammate::TeammateDetectorOptions& d = detector_;
   const float min_reflectivity = static_cast<float>(d.clustering.min_reflectivity);
@@ -38,7 +40,7 @@ void DetectorInput::Select(const LidarScan& raw, int64_t t_k, const SwarmState& 
   const Eigen::Matrix3d R_b_G = x.ego.R_G_b().transpose();
   std::vector<Eigen::Vector3f> centers_in_lidar;
   for (const teammate::TrackerState& s : last_detection.trackers) {
-    const double dt = Seconds(t_k) - last_detection_s;
+    const double dt = SecondsBetween(last_detection_ns, t_k);
     const Eigen::Vector3d p_in_b = R_b_G * (s.p_in_Gi + s.v_in_Gi * dt - x.ego.p_b_in_G);
     centers_in_lidar.push_back(
         (R_imu_lidar.transpose() * (p_in_b - lidar_.p_lidar_in_imu_m)).cast<float>());

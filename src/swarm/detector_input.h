@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "swarmlio/common/time.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/undistortion.h"
@@ -26,16 +27,16 @@ class DetectorInput {
 
   /// The detector's points of `raw` (t_k: its end, `poses`: propagated over
   /// it), given the predicted state `x` and the trackers of the last
-  /// detection (made at last_detection_s).
+  /// detection (made at last_detection_ns).
   Status Make(const LidarScan& raw, int64_t t_k, const std::vector<ImuPose>& poses,
               const SwarmState& x, const teammate::ScanResult& last_detection,
-              double last_detection_s, std::vector<teammate::ScanPoint>* points);
+              int64_t last_detection_ns, std::vector<teammate::ScanPoint>* points);
 
  private:
   // The raw points the detector needs: tape returns and points near the
   // trackers of the last scan (predicted to t_k).
   void Select(const LidarScan& raw, int64_t t_k, const SwarmState& x,
-              const teammate::ScanResult& last_detection, double last_detection_s,
+              const teammate::ScanResult& last_detection, int64_t last_detection_ns,
               const Eigen::Matrix3d& R_imu_lidar);
 
   teammate::TeammateDetectorOptions detector_;

@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/swarm/drone_estimator.h"
 
 #include <algorithm>
@@ -41,7 +42,7 @@ struct DroneEstimator::Parts {
 
   std::unique_ptr<net::ClockSync> clock_sync;  // null when synchronize_clocks is off
   teammate::ScanResult detection;              // the last scan's
-  double last_detection_s = 0.0;
+  int64_t last_detection_ns = 0;
   internal::TeammateRegistry registry;
   internal::ObservationGate gate;
   // The updaters, called in this order (a new measurement type: one more here).
@@ -172,7 +173,7 @@ Status DroneEstimator::FrontEnd(lio::ScanContext* scan, lio::UpdateRequest* requ
   // scan's reflective points at full resolution. The trackers read T_Gi_Gj
   // from the state (its one owner).
   SWARMLIO_RETURN_IF_ERROR(p.detector_input.Make(scan->raw, t_k, *scan->poses, x, p.detection,
-                                                 p.last_detection_s, &p.points));
+                                                 p.last_detection_ns, &p.points));
   p.report.detector_points = static_cast<int>(p.points.size());
   for (int id : x.layout().teammate_ids()) {
     detector_->SetGlobalExtrinsic(id, x.teammate(id).T_Gi_Gj());
@@ -180,8 +181,8 @@ Status DroneEstimator::FrontEnd(lio::ScanContext* scan, lio::UpdateRequest* requ
   Eigen::Isometry3d T_Gi_bi = Eigen::Isometry3d::Identity();
   T_Gi_bi.linear() = x.ego.R_G_b();
   T_Gi_bi.translation() = x.ego.p_b_in_G;
-  SWARMLIO_RETURN_IF_ERROR(detector_->ProcessScan(internal::Seconds(t_k), T_Gi_bi, p.points, &p.detection));
-  p.last_detection_s = internal::Seconds(t_k);
+  SWARMLIO_RETURN_IF_ERROR(detector_->ProcessScan(t_k, T_Gi_bi, p.points, &p.detection));
+  p.last_detection_ns = t_k;
 
   // State blocks: new teammates in, lost or restarted ones out.
   p.registry.UpdateBlocks(t_k, p.detection, &x, &scan->P, &p.report, &counters_);

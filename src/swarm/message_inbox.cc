@@ -4,6 +4,7 @@
 #include <cmath>
 #include <variant>
 
+#include "swarmlio/common/time.h"
 #include "swarmlio/net/wire_format.h"
 
 namespace swarmlio::swarm::internal {
@@ -19,7 +20,7 @@ bool MessageInbox::MadeInSessionOf(int teammate_id, int sender_id, int64_t sende
   if (it == teammates.end() || it->second.session_heard_ns == 0) return true;
   int64_t local_ns = 0;
   if (!ToLocal(sender_id, sender_stamp_ns, &local_ns)) return false;  // its clock is not known yet
-  const int64_t margin_ns = static_cast<int64_t>(std::llround(options_.max_message_age_s * 1e9));
+  const int64_t margin_ns = ToNanoseconds(options_.max_message_age_s);
   return local_ns >= it->second.session_heard_ns + margin_ns;
 }
 
@@ -28,7 +29,7 @@ bool MessageInbox::MadeInThisSession(int sender_id, int64_t sender_stamp_ns,
   if (!own.started) return false;
   int64_t local_ns = 0;
   if (!ToLocal(sender_id, sender_stamp_ns, &local_ns)) return false;  // its clock is not known yet
-  const int64_t margin_ns = static_cast<int64_t>(std::llround(options_.max_message_age_s * 1e9));
+  const int64_t margin_ns = ToNanoseconds(options_.max_message_age_s);
   // Teammates hear this session with its first state message, sent once the
   // odometry started (after an in-flight initialization's passes).
   return local_ns >= own.started_ns + margin_ns;
@@ -128,7 +129,7 @@ void MessageInbox::OnState(const net::EgoStateMessage& received, int64_t arrival
   info.last_heard_ns = std::max(info.last_heard_ns, arrival_ns);
 
   teammate::TeammateOdometry odometry;
-  odometry.stamp_s = Seconds(m.stamp_ns);
+  odometry.stamp_ns = m.stamp_ns;
   odometry.drone_id = m.sender_id;
   odometry.p_bj_in_Gj = m.p_bj_in_Gj;
   odometry.q_Gj_bj = m.q_Gj_bj.normalized();
@@ -152,7 +153,7 @@ void MessageInbox::OnRestart(int j, int64_t arrival_ns) {
   // identification would compose them: off by its motion since its start).
   for (auto& [id, other] : teammates) other.identified.erase(j);
   info.taken_observation_stamps.clear();
-  to_.detector->RestartTeammate(j, Seconds(arrival_ns));
+  to_.detector->RestartTeammate(j, arrival_ns);
   to_.registry->ForgetMutual(j);
   to_.passive->ForgetSender(j);
 }

@@ -5,6 +5,8 @@
 #include <memory>
 #include <utility>
 
+#include "swarmlio/common/time.h"
+
 #include "factors/passive_observation_factor.h"
 #include "observation_terms.h"
 
@@ -32,7 +34,7 @@ void PassiveObservationUpdater::AddTerms(const UpdaterScan& scan, ObservationGat
       ++report->skipped_degenerate;
       continue;
     }
-    const double dt = Seconds(p.stamp_ns - scan.t_k);
+    const double dt = ToSeconds(p.stamp_ns - scan.t_k);
     if (std::abs(dt) > so.max_message_age_s) {
       ++report->rejected;
       ++counters_->observations_rejected;

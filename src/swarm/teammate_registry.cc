@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include "swarmlio/common/time.h"
+
 #include "observation_terms.h"
 
 namespace swarmlio::swarm::internal {
@@ -93,7 +95,7 @@ void TeammateRegistry::AddMutual(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P,
     GlobalExtrinsic T;
     Eigen::Matrix<double, 6, 6> C;
     InvertExtrinsic(pending.entry, &T, &C);
-    if (!detector_->AddIdentifiedTeammate(j, Seconds(t_k), T.R_Gi_Gj(), T.p_Gj_in_Gi)) continue;
+    if (!detector_->AddIdentifiedTeammate(j, t_k, T.R_Gi_Gj(), T.p_Gj_in_Gi)) continue;
     // Positive definite whatever arrived, and at least the covariance of an
     // own match with zero residual.
     C = Regularized<6>(C, 1e-10);
@@ -143,7 +145,7 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
     }
   }
   for (const auto& [k, c] : best) {
-    if (!detector_->AddIdentifiedTeammate(k, Seconds(t_k), c.T.R_Gi_Gj(), c.T.p_Gj_in_Gi)) continue;
+    if (!detector_->AddIdentifiedTeammate(k, t_k, c.T.R_Gi_Gj(), c.T.p_Gj_in_Gi)) continue;
     // Cross-covariances: d(T_ik) = J_ij d(T_ij) + J_jk d(T_jk) with d(T_jk)
     // independent of this drone's state, so P(k, :) = J_ij P(j, :).
     const int n = static_cast<int>(P->rows());
@@ -170,7 +172,7 @@ void TeammateRegistry::RemoveLost(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P
   for (int id : ids) {
     TeammateInfo& info = teammates_[id];
     const int64_t last = std::max(info.last_seen_ns, info.last_heard_ns);
-    const bool lost = Seconds(t_k - last) > options_.teammate_timeout_s;
+    const bool lost = ToSeconds(t_k - last) > options_.teammate_timeout_s;
     if (!lost && !info.restarted) continue;
     EraseCovarianceBlock(x->layout().TeammateBlock(id), P);
     x->RemoveTeammate(id);
@@ -196,8 +198,8 @@ std::vector<TeammateEstimate> TeammateRegistry::Estimates(int64_t t_k, const Swa
     e.extrinsic_covariance = P.block<6, 6>(block.offset, block.offset);
     const TeammateInfo& info = teammates_[id];
     if (info.have_message &&
-        std::abs(Seconds(t_k - info.last.stamp_ns)) <= options_.max_message_age_s) {
-      const PredictedTeammate j = Predict(info.last, Seconds(t_k - info.last.stamp_ns));
+        std::abs(ToSeconds(t_k - info.last.stamp_ns)) <= options_.max_message_age_s) {
+      const PredictedTeammate j = Predict(info.last, ToSeconds(t_k - info.last.stamp_ns));
       const Eigen::Matrix3d R_Gi_Gj = e.T_Gi_Gj.R_Gi_Gj();
       e.have_pose = true;
       e.q_Gi_bj = Eigen::Quaterniond(R_Gi_Gj * j.R_Gj_bj).normalized();

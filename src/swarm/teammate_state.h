@@ -10,14 +10,12 @@
 #include <deque>
 #include <map>
 
+#include "swarmlio/common/time.h"
 #include "swarmlio/net/messages.h"
 #include "swarmlio/state/swarm_state.h"
 #include "swarmlio/swarm/swarm_options.h"
 
 namespace swarmlio::swarm::internal {
-
-/// A stamp or an interval in int64 ns as seconds.
-inline double Seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
 /// The message is finite in every field the estimator uses.
 bool Finite(const net::EgoStateMessage& m);

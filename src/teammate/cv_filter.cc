@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/cv_filter.h"
 
 #include <Eigen/Cholesky>
@@ -5,19 +6,19 @@
 
 namespace swarmlio::teammate {
 
-void ConstantVelocityFilter::Initialize(double stamp_s, const Eigen::Vector3d& p_in_G,
+void ConstantVelocityFilter::Initialize(int64_t stamp_ns, const Eigen::Vector3d& p_in_G,
                                         const Eigen::Vector3d& v_in_G, double position_sigma_m,
                                         double velocity_sigma_m_s) {
-  stamp_s_ = stamp_s;
+  stamp_ns_ = stamp_ns;
   x_ << p_in_G, v_in_G;
   P_.setZero();
   P_.topLeftCorner<3, 3>().diagonal().setConstant(position_sigma_m * position_sigma_m);
   P_.bottomRightCorner<3, 3>().diagonal().setConstant(velocity_sigma_m_s * velocity_sigma_m_s);
 }
 
-void ConstantVelocityFilter::PredictTo(double stamp_s, double accel_noise_density_m_s2_sqrt_hz) {
-  const double dt = stamp_s - stamp_s_;
-  stamp_s_ = stamp_s;
+void ConstantVelocityFilter::PredictTo(int64_t stamp_ns, double accel_noise_density_m_s2_sqrt_hz) {
+  const double dt = SecondsBetween(stamp_ns_, stamp_ns);
+  stamp_ns_ = stamp_ns;
   if (dt == 0.0) return;
   Matrix6d F = Matrix6d::Identity();
   F.topRightCorner<3, 3>().diagonal().setConstant(dt);
@@ -32,10 +33,10 @@ void ConstantVelocityFilter::PredictTo(double stamp_s, double accel_noise_densit
   P_ = F * P_ * F.transpose() + Q;
 }
 
-void ConstantVelocityFilter::PredictWithVelocity(double stamp_s, const Eigen::Vector3d& v_in_G,
+void ConstantVelocityFilter::PredictWithVelocity(int64_t stamp_ns, const Eigen::Vector3d& v_in_G,
                                                  double velocity_sigma_m_s) {
-  const double dt = stamp_s - stamp_s_;
-  stamp_s_ = stamp_s;
+  const double dt = SecondsBetween(stamp_ns_, stamp_ns);
+  stamp_ns_ = stamp_ns;
   x_.tail<3>() = v_in_G;
   x_.head<3>() += v_in_G * dt;
   const double var_v = velocity_sigma_m_s * velocity_sigma_m_s;

@@ -46,13 +46,13 @@ ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptio
   return centre;
 }
 
-TeammateObservation MakeObservation(int drone_id, double stamp_s, const PointCluster& cluster,
+TeammateObservation MakeObservation(int drone_id, int64_t stamp_ns, const PointCluster& cluster,
                                     const Eigen::Vector3d& v_bj_in_bi,
                                     const ObservationOptions& options,
                                     const Eigen::Matrix3d* R_bi_bj) {
   TeammateObservation out;
   out.drone_id = drone_id;
-  out.stamp_s = stamp_s;
+  out.stamp_ns = stamp_ns;
   out.num_points = cluster.num_points;
   const ClusterCentre centre = EstimateCentre(cluster, options, R_bi_bj);
   out.capture_offset_s = centre.time_offset_s;

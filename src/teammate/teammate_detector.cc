@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/teammate_detector.h"
 
 #include <algorithm>
@@ -28,17 +29,16 @@ TeammateDetector::~TeammateDetector() = default;
 
 void TeammateDetector::AddTeammateOdometry(const TeammateOdometry& odometry) {
   if (odometry.drone_id == self_id_ || odometry.drone_id < 0) return;
-  if (!std::isfinite(odometry.stamp_s) || !odometry.p_bj_in_Gj.allFinite() ||
-      !odometry.v_bj_in_Gj.allFinite()) {
+  if (!odometry.p_bj_in_Gj.allFinite() || !odometry.v_bj_in_Gj.allFinite()) {
     return;
   }
   odometry_[odometry.drone_id].Add(odometry, options_.matching.odometry_keep_s);
 }
 
-Status TeammateDetector::ProcessScan(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+Status TeammateDetector::ProcessScan(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                                      const std::vector<ScanPoint>& points, ScanResult* result) {
-  if (!std::isfinite(stamp_s) || !T_Gi_bi.matrix().allFinite()) {
-    return Status::InvalidArgument("teammate detector: non-finite scan stamp or pose");
+  if (!T_Gi_bi.matrix().allFinite()) {
+    return Status::InvalidArgument("teammate detector: non-finite scan pose");
   }
   *result = ScanResult();
   clusterer_.FindReflectiveClusters(points, &clusters_, &result->num_reflective_points);
@@ -46,12 +46,11 @@ Status TeammateDetector::ProcessScan(double stamp_s, const Eigen::Isometry3d& T_
   std::vector<bool> available(clusters_.size());
   for (size_t k = 0; k < clusters_.size(); ++k) available[k] = clusterer_.IsDroneSized(clusters_[k]);
 
-  TrackTeammates(stamp_s, T_Gi_bi, points, &available, result);
-  TrackTemporary(stamp_s, T_Gi_bi, points, &available, result);
-  StartTrackers(stamp_s, T_Gi_bi, available);
-  Identify(stamp_s, result);
-  FillOutputs(stamp_s, T_Gi_bi, points, result);
-  last_stamp_s_ = stamp_s;
+  TrackTeammates(stamp_ns, T_Gi_bi, points, &available, result);
+  TrackTemporary(stamp_ns, T_Gi_bi, points, &available, result);
+  StartTrackers(stamp_ns, T_Gi_bi, available);
+  Identify(stamp_ns, result);
+  FillOutputs(stamp_ns, T_Gi_bi, points, result);
   return Status::Ok();
 }
 
@@ -68,7 +67,7 @@ bool TeammateDetector::ClusterPredictedRegion(const std::vector<ScanPoint>& poin
   return (CentreInB(*cluster, options_.observation) - center_in_b).norm() <= gate_m;
 }
 
-void TeammateDetector::TrackTeammates(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+void TeammateDetector::TrackTeammates(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                                       const std::vector<ScanPoint>& points,
                                       std::vector<bool>* available, ScanResult* result) {
   seen_teammates_.clear();
@@ -77,7 +76,7 @@ void TeammateDetector::TrackTeammates(double stamp_s, const Eigen::Isometry3d& T
   std::vector<Eigen::Vector3d> predictions_in_b;
   for (const auto& [id, tracker] : teammates_) {
     predictions_in_b.push_back(
-        T_bi_Gi * tracker.PositionAt(stamp_s, odometry_[id], options_.teammate));
+        T_bi_Gi * tracker.PositionAt(stamp_ns, odometry_[id], options_.teammate));
   }
   std::vector<Eigen::Vector3d> centres_in_b;
   for (const PointCluster& c : clusters_) centres_in_b.push_back(CentreInB(c, options_.observation));
@@ -99,7 +98,7 @@ void TeammateDetector::TrackTeammates(double stamp_s, const Eigen::Isometry3d& T
     }
     ++k;
     if (!seen) {
-      tracker.UpdateOdometry(stamp_s, history, options_.teammate);
+      tracker.UpdateOdometry(stamp_ns, history, options_.teammate);
       continue;
     }
     // The teammate's attitude relative to mine, from its broadcast through
@@ -109,18 +108,18 @@ void TeammateDetector::TrackTeammates(double stamp_s, const Eigen::Isometry3d& T
     Eigen::Matrix3d R_bi_bj;
     const bool attitude_known =
         options_.observation.UsesTapeBand() &&
-        history.AttitudeAt(stamp_s, options_.teammate.max_odometry_age_s, &q_Gj_bj);
+        history.AttitudeAt(stamp_ns, options_.teammate.max_odometry_age_s, &q_Gj_bj);
     if (attitude_known) {
       R_bi_bj = T_Gi_bi.linear().transpose() * tracker.R_Gi_Gj() * q_Gj_bj.toRotationMatrix();
     }
     const Eigen::Matrix3d* R_bi_bj_known = attitude_known ? &R_bi_bj : nullptr;
     const ClusterCentre centre = EstimateCentre(cluster, options_.observation, R_bi_bj_known);
-    tracker.UpdateLidar(stamp_s + centre.time_offset_s, T_Gi_bi * centre.p_in_b, history,
+    tracker.UpdateLidar(stamp_ns + ToNanoseconds(centre.time_offset_s), T_Gi_bi * centre.p_in_b, history,
                         options_.teammate);
     Eigen::Vector3d v_in_Gi = tracker.filter().v();
-    tracker.VelocityInGi(stamp_s, history, options_.teammate, &v_in_Gi);
+    tracker.VelocityInGi(stamp_ns, history, options_.teammate, &v_in_Gi);
     if (cluster.centroid_in_b.norm() >= options_.observation.min_range_m) {
-      result->observations.push_back(MakeObservation(id, stamp_s, cluster,
+      result->observations.push_back(MakeObservation(id, stamp_ns, cluster,
                                                      T_Gi_bi.linear().transpose() * v_in_Gi,
                                                      options_.observation, R_bi_bj_known));
     }
@@ -128,7 +127,7 @@ void TeammateDetector::TrackTeammates(double stamp_s, const Eigen::Isometry3d& T
   }
 }
 
-void TeammateDetector::TrackTemporary(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+void TeammateDetector::TrackTemporary(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                                       const std::vector<ScanPoint>& points,
                                       std::vector<bool>* available, ScanResult* result) {
   seen_temporary_.assign(temporary_.size(), false);
@@ -136,7 +135,7 @@ void TeammateDetector::TrackTemporary(double stamp_s, const Eigen::Isometry3d& T
   const Eigen::Isometry3d T_bi_Gi = T_Gi_bi.inverse();
   std::vector<Eigen::Vector3d> predictions_in_b;
   for (const TemporaryTracker& tracker : temporary_) {
-    predictions_in_b.push_back(T_bi_Gi * tracker.PositionAt(stamp_s));
+    predictions_in_b.push_back(T_bi_Gi * tracker.PositionAt(stamp_ns));
   }
   std::vector<Eigen::Vector3d> centres_in_b;
   for (const PointCluster& c : clusters_) centres_in_b.push_back(CentreInB(c, options_.observation));
@@ -156,20 +155,20 @@ void TeammateDetector::TrackTemporary(double stamp_s, const Eigen::Isometry3d& T
     if (!seen) continue;
     seen_temporary_[k] = true;
     const ClusterCentre centre = EstimateCentre(cluster, options_.observation);
-    temporary_[k].Update(stamp_s + centre.time_offset_s, T_Gi_bi * centre.p_in_b,
+    temporary_[k].Update(stamp_ns + ToNanoseconds(centre.time_offset_s), T_Gi_bi * centre.p_in_b,
                          options_.temporary);
   }
 }
 
-void TeammateDetector::StartTrackers(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+void TeammateDetector::StartTrackers(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                                      const std::vector<bool>& available) {
   created_ids_.clear();
   // Trackers' positions now, in G_i: a leftover cluster near one is the same object.
   std::vector<Eigen::Vector3d> tracked_in_Gi;
   for (const auto& [id, tracker] : teammates_) {
-    tracked_in_Gi.push_back(tracker.PositionAt(stamp_s, odometry_[id], options_.teammate));
+    tracked_in_Gi.push_back(tracker.PositionAt(stamp_ns, odometry_[id], options_.teammate));
   }
-  for (const TemporaryTracker& tracker : temporary_) tracked_in_Gi.push_back(tracker.PositionAt(stamp_s));
+  for (const TemporaryTracker& tracker : temporary_) tracked_in_Gi.push_back(tracker.PositionAt(stamp_ns));
   const double same2 = options_.association.same_object_m * options_.association.same_object_m;
   for (size_t k = 0; k < clusters_.size(); ++k) {
     if (!available[k]) continue;
@@ -182,7 +181,7 @@ void TeammateDetector::StartTrackers(double stamp_s, const Eigen::Isometry3d& T_
                                    });
     if (known) continue;
     const int id = next_tracker_id_++;
-    temporary_.emplace_back(id, stamp_s + centre.time_offset_s, p_in_Gi,
+    temporary_.emplace_back(id, stamp_ns + ToNanoseconds(centre.time_offset_s), p_in_Gi,
                             options_.temporary, options_.excitation.max_positions);
     seen_temporary_.push_back(true);
     created_ids_.push_back(id);
@@ -194,16 +193,16 @@ void TeammateDetector::StartTrackers(double stamp_s, const Eigen::Isometry3d& T_
   // older temporary tracker (two trackers that converged on one object).
   std::vector<bool> remove(temporary_.size(), false);
   for (size_t a = 0; a < temporary_.size(); ++a) {
-    if (temporary_[a].Expired(stamp_s, options_.temporary)) remove[a] = true;
-    const Eigen::Vector3d pa = temporary_[a].PositionAt(stamp_s);
+    if (temporary_[a].Expired(stamp_ns, options_.temporary)) remove[a] = true;
+    const Eigen::Vector3d pa = temporary_[a].PositionAt(stamp_ns);
     for (const auto& [id, tracker] : teammates_) {
-      if ((tracker.PositionAt(stamp_s, odometry_[id], options_.teammate) - pa).squaredNorm() <= same2) {
+      if ((tracker.PositionAt(stamp_ns, odometry_[id], options_.teammate) - pa).squaredNorm() <= same2) {
         remove[a] = true;
       }
     }
     for (size_t b = 0; b < a && !remove[a]; ++b) {
       if (remove[b]) continue;
-      if ((temporary_[b].PositionAt(stamp_s) - pa).squaredNorm() <= same2) {
+      if ((temporary_[b].PositionAt(stamp_ns) - pa).squaredNorm() <= same2) {
         // Keep the one with the longer trajectory (ties: the older one, b).
         if (temporary_[a].trajectory().size() > temporary_[b].trajectory().size()) {
           remove[b] = true;
@@ -230,14 +229,17 @@ void TeammateDetector::RemoveTemporary(const std::vector<bool>& remove) {
   seen_temporary_.resize(kept);
 }
 
-void TeammateDetector::Identify(double stamp_s, ScanResult* result) {
+void TeammateDetector::Identify(int64_t stamp_ns, ScanResult* result) {
   std::vector<bool> remove(temporary_.size(), false);
   for (size_t k = 0; k < temporary_.size(); ++k) {
     TemporaryTracker& tracker = temporary_[k];
     if (!seen_temporary_[k]) continue;
-    if (stamp_s - tracker.last_match_s() < options_.matching.match_interval_s) continue;
+    if (tracker.matched_before() &&
+        SecondsBetween(tracker.last_match_ns(), stamp_ns) < options_.matching.match_interval_s) {
+      continue;
+    }
     if (!IsExcited(tracker.trajectory(), options_.excitation)) continue;
-    tracker.set_last_match_s(stamp_s);
+    tracker.set_last_match_ns(stamp_ns);
     std::vector<MatchCandidate> candidates;
     for (const auto& [id, history] : odometry_) {
       MatchCandidate candidate;
@@ -266,7 +268,7 @@ void TeammateDetector::Identify(double stamp_s, ScanResult* result) {
     TeammateIdentification id;
     id.drone_id = match.drone_id;
     id.tracker_id = tracker.id();
-    id.stamp_s = stamp_s;
+    id.stamp_ns = stamp_ns;
     id.R_Gi_Gj = match.match.R_Gi_Gj;
     id.p_Gj_in_Gi = match.match.p_Gj_in_Gi;
     id.mean_residual_m = match.match.mean_residual_m;
@@ -277,7 +279,7 @@ void TeammateDetector::Identify(double stamp_s, ScanResult* result) {
   RemoveTemporary(remove);
 }
 
-void TeammateDetector::FillOutputs(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+void TeammateDetector::FillOutputs(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                                    const std::vector<ScanPoint>& points, ScanResult* result) {
   const Eigen::Isometry3d T_bi_Gi = T_Gi_bi.inverse();
   std::vector<Eigen::Vector3d> centres_in_b;
@@ -286,7 +288,7 @@ void TeammateDetector::FillOutputs(double stamp_s, const Eigen::Isometry3d& T_Gi
     TrackerState state;
     state.tracker_id = tracker.tracker_id();
     state.drone_id = id;
-    state.p_in_Gi = tracker.PositionAt(stamp_s, odometry_[id], options_.teammate);
+    state.p_in_Gi = tracker.PositionAt(stamp_ns, odometry_[id], options_.teammate);
     state.v_in_Gi = tracker.filter().v();
     state.seen = std::find(seen_teammates_.begin(), seen_teammates_.end(), id) !=
                  seen_teammates_.end();
@@ -298,7 +300,7 @@ void TeammateDetector::FillOutputs(double stamp_s, const Eigen::Isometry3d& T_Gi
     const TemporaryTracker& tracker = temporary_[k];
     TrackerState state;
     state.tracker_id = tracker.id();
-    state.p_in_Gi = tracker.PositionAt(stamp_s);
+    state.p_in_Gi = tracker.PositionAt(stamp_ns);
     state.v_in_Gi = tracker.filter().v();
     state.seen = seen_temporary_[k];
     state.created = std::find(created_ids_.begin(), created_ids_.end(), tracker.id()) !=
@@ -332,7 +334,7 @@ bool TeammateDetector::SetGlobalExtrinsic(int drone_id, const Eigen::Isometry3d&
   return true;
 }
 
-bool TeammateDetector::AddIdentifiedTeammate(int drone_id, double stamp_s,
+bool TeammateDetector::AddIdentifiedTeammate(int drone_id, int64_t stamp_ns,
                                              const Eigen::Matrix3d& R_Gi_Gj,
                                              const Eigen::Vector3d& p_Gj_in_Gi) {
   if (teammates_.count(drone_id) > 0) return false;
@@ -340,12 +342,12 @@ bool TeammateDetector::AddIdentifiedTeammate(int drone_id, double stamp_s,
   if (it == odometry_.end()) return false;
   const TeammateTrackerOptions& o = options_.teammate;
   Eigen::Vector3d p_bj_in_Gj, v_bj_in_Gj;
-  if (!it->second.StateAt(stamp_s, o.max_odometry_age_s, o.max_odometry_age_s, &p_bj_in_Gj,
+  if (!it->second.StateAt(stamp_ns, o.max_odometry_age_s, o.max_odometry_age_s, &p_bj_in_Gj,
                           &v_bj_in_Gj)) {
     return false;
   }
   ConstantVelocityFilter filter;
-  filter.Initialize(stamp_s, R_Gi_Gj * p_bj_in_Gj + p_Gj_in_Gi, R_Gi_Gj * v_bj_in_Gj,
+  filter.Initialize(stamp_ns, R_Gi_Gj * p_bj_in_Gj + p_Gj_in_Gi, R_Gi_Gj * v_bj_in_Gj,
                     o.odometry_position_sigma_m, o.velocity_sigma_m_s);
   teammates_.emplace(drone_id,
                      TeammateTracker(drone_id, next_tracker_id_++, R_Gi_Gj, p_Gj_in_Gi, filter,
@@ -353,10 +355,10 @@ bool TeammateDetector::AddIdentifiedTeammate(int drone_id, double stamp_s,
   return true;
 }
 
-bool TeammateDetector::RestartTeammate(int drone_id, double stamp_s) {
+bool TeammateDetector::RestartTeammate(int drone_id, int64_t stamp_ns) {
   const auto it = teammates_.find(drone_id);
   if (it != teammates_.end() && !it->second.seen_trajectory().empty()) {
-    temporary_.emplace_back(it->second.tracker_id(), stamp_s, it->second.filter(),
+    temporary_.emplace_back(it->second.tracker_id(), stamp_ns, it->second.filter(),
                             it->second.seen_trajectory());
     seen_temporary_.push_back(false);
   }

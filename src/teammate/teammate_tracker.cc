@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/teammate_tracker.h"
 
 #include <cmath>
@@ -23,16 +24,16 @@ bool ReportsDegeneracy(const OdometryHistory& history) {
 
 }  // namespace
 
-bool TeammateTracker::VelocityInGi(double stamp_s, const OdometryHistory& history,
+bool TeammateTracker::VelocityInGi(int64_t stamp_ns, const OdometryHistory& history,
                                    const TeammateTrackerOptions& options,
                                    Eigen::Vector3d* v_in_Gi) const {
   if (ReportsDegeneracy(history)) {
     *v_in_Gi = filter_.v();
     return true;
   }
-  if (history.empty() || stamp_s - history.newest().stamp_s > options.disconnect_s) return false;
+  if (history.empty() || SecondsBetween(history.newest().stamp_ns, stamp_ns) > options.disconnect_s) return false;
   Eigen::Vector3d p_bj_in_Gj, v_bj_in_Gj;
-  if (!history.StateAt(stamp_s, options.max_odometry_age_s, options.max_odometry_age_s,
+  if (!history.StateAt(stamp_ns, options.max_odometry_age_s, options.max_odometry_age_s,
                        &p_bj_in_Gj, &v_bj_in_Gj)) {
     v_bj_in_Gj = history.newest().v_bj_in_Gj;
   }
@@ -40,40 +41,39 @@ bool TeammateTracker::VelocityInGi(double stamp_s, const OdometryHistory& histor
   return true;
 }
 
-void TeammateTracker::Predict(double stamp_s, const OdometryHistory& history,
+void TeammateTracker::Predict(int64_t stamp_ns, const OdometryHistory& history,
                               const TeammateTrackerOptions& options) {
   if (ReportsDegeneracy(history)) {
-    filter_.PredictTo(stamp_s, options.degenerate_accel_noise_m_s2_sqrt_hz);
+    filter_.PredictTo(stamp_ns, options.degenerate_accel_noise_m_s2_sqrt_hz);
     return;
   }
   Eigen::Vector3d v_in_Gi;
-  if (!VelocityInGi(stamp_s, history, options, &v_in_Gi)) v_in_Gi.setZero();
-  filter_.PredictWithVelocity(stamp_s, v_in_Gi, options.velocity_sigma_m_s);
+  if (!VelocityInGi(stamp_ns, history, options, &v_in_Gi)) v_in_Gi.setZero();
+  filter_.PredictWithVelocity(stamp_ns, v_in_Gi, options.velocity_sigma_m_s);
 }
 
-Eigen::Vector3d TeammateTracker::PositionAt(double stamp_s, const OdometryHistory& history,
+Eigen::Vector3d TeammateTracker::PositionAt(int64_t stamp_ns, const OdometryHistory& history,
                                             const TeammateTrackerOptions& options) const {
   Eigen::Vector3d v_in_Gi;
-  if (!VelocityInGi(stamp_s, history, options, &v_in_Gi)) return filter_.p();
-  return filter_.p() + v_in_Gi * (stamp_s - filter_.stamp_s());
+  if (!VelocityInGi(stamp_ns, history, options, &v_in_Gi)) return filter_.p();
+  return filter_.p() + v_in_Gi * SecondsBetween(filter_.stamp_ns(), stamp_ns);
 }
 
-void TeammateTracker::UpdateLidar(double stamp_s, const Eigen::Vector3d& p_in_Gi,
+void TeammateTracker::UpdateLidar(int64_t stamp_ns, const Eigen::Vector3d& p_in_Gi,
                                   const OdometryHistory& history,
                                   const TeammateTrackerOptions& options) {
-  Predict(stamp_s, history, options);
+  Predict(stamp_ns, history, options);
   const double sigma = options.lidar_position_sigma_m;
   filter_.Update(p_in_Gi, sigma * sigma * Eigen::Matrix3d::Identity());
-  last_lidar_update_s_ = stamp_s;
-  seen_.Push(stamp_s, p_in_Gi);
+  seen_.Push(stamp_ns, p_in_Gi);
 }
 
-bool TeammateTracker::UpdateOdometry(double stamp_s, const OdometryHistory& history,
+bool TeammateTracker::UpdateOdometry(int64_t stamp_ns, const OdometryHistory& history,
                                      const TeammateTrackerOptions& options) {
-  Predict(stamp_s, history, options);
+  Predict(stamp_ns, history, options);
   if (ReportsDegeneracy(history)) return false;
   Eigen::Vector3d p_bj_in_Gj;
-  if (!history.StateAt(stamp_s, options.max_odometry_age_s, options.max_odometry_age_s,
+  if (!history.StateAt(stamp_ns, options.max_odometry_age_s, options.max_odometry_age_s,
                        &p_bj_in_Gj, nullptr)) {
     return false;
   }

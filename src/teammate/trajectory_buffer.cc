@@ -15,8 +15,8 @@ Eigen::Vector3d SortedEigenvalues(const Eigen::Matrix3d& scatter) {
 
 }  // namespace
 
-void TrajectoryBuffer::Push(double stamp_s, const Eigen::Vector3d& p) {
-  samples_.push_back({stamp_s, p});
+void TrajectoryBuffer::Push(int64_t stamp_ns, const Eigen::Vector3d& p) {
+  samples_.push_back({stamp_ns, p});
   while (static_cast<int>(samples_.size()) > capacity_) samples_.pop_front();
 }
 

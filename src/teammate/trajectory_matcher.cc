@@ -28,7 +28,7 @@ Status MatchTrajectory(const TrajectoryBuffer& tracker_in_Gi, const OdometryHist
   int n = 0;
   for (auto it = samples.rbegin(); it != samples.rend() && n < src.cols(); ++it) {
     Eigen::Vector3d p_bj_in_Gj;
-    if (!teammate.StateAt(it->stamp_s, options.max_gap_s, options.max_extrapolation_s, &p_bj_in_Gj,
+    if (!teammate.StateAt(it->stamp_ns, options.max_gap_s, options.max_extrapolation_s, &p_bj_in_Gj,
                           nullptr)) {
       continue;
     }

@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/cv_filter.h"
 
 #include <gtest/gtest.h>
@@ -11,12 +12,12 @@ namespace {
 
 TEST(ConstantVelocityFilter, PredictionFollowsTheModel) {
   ConstantVelocityFilter filter;
-  filter.Initialize(1.0, Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(0.5, -1, 0), 0.1, 1.0);
-  EXPECT_TRUE(filter.PositionAt(3.0).isApprox(Eigen::Vector3d(2, 0, 3)));
+  filter.Initialize(ToNanoseconds(1.0), Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(0.5, -1, 0), 0.1, 1.0);
+  EXPECT_TRUE(filter.PositionAt(ToNanoseconds(3.0)).isApprox(Eigen::Vector3d(2, 0, 3)));
   const double q = 2.0;
   const ConstantVelocityFilter::Matrix6d P0 = filter.P();
-  filter.PredictTo(1.5, q);
-  EXPECT_DOUBLE_EQ(filter.stamp_s(), 1.5);
+  filter.PredictTo(ToNanoseconds(1.5), q);
+  EXPECT_EQ(filter.stamp_ns(), 1'500'000'000);
   EXPECT_TRUE(filter.p().isApprox(Eigen::Vector3d(1.25, 1.5, 3)));
   // P' = F P F^T + Q for one axis: [s_p + dt^2 s_v + q dt^3/3, dt s_v + q dt^2/2; ., s_v + q dt].
   const double dt = 0.5, sp = P0(0, 0), sv = P0(3, 3);
@@ -31,11 +32,11 @@ TEST(ConstantVelocityFilter, ConvergesToAConstantVelocityTarget) {
   std::normal_distribution<double> noise(0.0, 0.03);
   const Eigen::Vector3d p0(4, -1, 1), v(0.8, 0.3, -0.1);
   ConstantVelocityFilter filter;
-  filter.Initialize(0.0, p0, Eigen::Vector3d::Zero(), 0.03, 1.0);
+  filter.Initialize(0, p0, Eigen::Vector3d::Zero(), 0.03, 1.0);
   const Eigen::Matrix3d R = 0.03 * 0.03 * Eigen::Matrix3d::Identity();
   for (int k = 1; k <= 100; ++k) {
     const double t = 0.1 * k;
-    filter.PredictTo(t, 0.05);
+    filter.PredictTo(ToNanoseconds(t), 0.05);
     const Eigen::Vector3d z = p0 + v * t + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
     const double nis = filter.Update(z, R);
     EXPECT_LT(nis, 30.0);
@@ -51,8 +52,8 @@ TEST(ConstantVelocityFilter, ConvergesToAConstantVelocityTarget) {
 
 TEST(ConstantVelocityFilter, PredictionWithAKnownVelocity) {
   ConstantVelocityFilter filter;
-  filter.Initialize(0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.1, 1.0);
-  filter.PredictWithVelocity(2.0, Eigen::Vector3d(1, 0, 0), 0.1);
+  filter.Initialize(0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.1, 1.0);
+  filter.PredictWithVelocity(ToNanoseconds(2.0), Eigen::Vector3d(1, 0, 0), 0.1);
   EXPECT_TRUE(filter.p().isApprox(Eigen::Vector3d(2, 0, 0)));
   EXPECT_TRUE(filter.v().isApprox(Eigen::Vector3d(1, 0, 0)));
   EXPECT_NEAR(filter.P()(0, 0), 0.01 + 0.01 * 4.0, 1e-12);

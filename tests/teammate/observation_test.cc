@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/observation.h"
 
 #include <gtest/gtest.h>
@@ -22,9 +23,9 @@ TEST(Observation, DepthOffsetAlongTheLineOfSight) {
   ObservationOptions options;
   options.compensate_target_motion = false;
   const TeammateObservation o =
-      MakeObservation(2, 10.0, ClusterAt(Eigen::Vector3d(3, 4, 0), -0.05), Eigen::Vector3d(1, 0, 0), options);
+      MakeObservation(2, ToNanoseconds(10.0), ClusterAt(Eigen::Vector3d(3, 4, 0), -0.05), Eigen::Vector3d(1, 0, 0), options);
   EXPECT_EQ(o.drone_id, 2);
-  EXPECT_EQ(o.stamp_s, 10.0);
+  EXPECT_EQ(o.stamp_ns, ToNanoseconds(10.0));
   EXPECT_TRUE(o.p_bj_in_bi.isApprox(Eigen::Vector3d(3, 4, 0) * (5.07 / 5.0)));
 }
 
@@ -33,7 +34,7 @@ TEST(Observation, TargetMotionToTheScanStamp) {
   options.centroid_depth_offset_m = 0.0;
   // Seen 0.05 s before the stamp, moving at 1 m/s along y: 5 cm further at the stamp.
   const TeammateObservation o =
-      MakeObservation(1, 0.0, ClusterAt(Eigen::Vector3d(4, 0, 0), -0.05), Eigen::Vector3d(0, 1, 0), options);
+      MakeObservation(1, 0, ClusterAt(Eigen::Vector3d(4, 0, 0), -0.05), Eigen::Vector3d(0, 1, 0), options);
   EXPECT_TRUE(o.p_bj_in_bi.isApprox(Eigen::Vector3d(4, 0.05, 0)));
   EXPECT_DOUBLE_EQ(o.capture_offset_s, -0.05);
 }

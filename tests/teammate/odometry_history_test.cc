@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/odometry_history.h"
 
 #include <gtest/gtest.h>
@@ -7,7 +8,7 @@ namespace {
 
 TeammateOdometry Message(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
   TeammateOdometry m;
-  m.stamp_s = t;
+  m.stamp_ns = ToNanoseconds(t);
   m.drone_id = 1;
   m.p_bj_in_Gj = p;
   m.v_bj_in_Gj = v;
@@ -20,7 +21,7 @@ TEST(OdometryHistory, SortsReplacesAndForgets) {
   h.Add(Message(1.0, Eigen::Vector3d(1, 0, 0), Eigen::Vector3d::Zero()), 10.0);  // late
   h.Add(Message(2.0, Eigen::Vector3d(5, 0, 0), Eigen::Vector3d::Zero()), 10.0);  // same stamp
   ASSERT_EQ(h.size(), 2);
-  EXPECT_EQ(h.messages().front().stamp_s, 1.0);
+  EXPECT_EQ(h.messages().front().stamp_ns, ToNanoseconds(1.0));
   EXPECT_EQ(h.newest().p_bj_in_Gj.x(), 5.0);
   h.Add(Message(20.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()), 10.0);
   EXPECT_EQ(h.size(), 1);
@@ -34,33 +35,33 @@ TEST(OdometryHistory, HermiteInterpolationIsExactForCubics) {
   h.Add(Message(1.0, p(1.0), v(1.0)), 10.0);
   h.Add(Message(1.3, p(1.3), v(1.3)), 10.0);
   Eigen::Vector3d q, w;
-  ASSERT_TRUE(h.StateAt(1.17, 0.35, 0.05, &q, &w));
+  ASSERT_TRUE(h.StateAt(ToNanoseconds(1.17), 0.35, 0.05, &q, &w));
   EXPECT_LT((q - p(1.17)).norm(), 1e-12);
   // Across a gap wider than max_gap_s: only extrapolation near a message.
-  EXPECT_FALSE(h.StateAt(1.17, 0.2, 0.05, &q, &w));
-  ASSERT_TRUE(h.StateAt(1.33, 0.35, 0.05, &q, &w));
+  EXPECT_FALSE(h.StateAt(ToNanoseconds(1.17), 0.2, 0.05, &q, &w));
+  ASSERT_TRUE(h.StateAt(ToNanoseconds(1.33), 0.35, 0.05, &q, &w));
   EXPECT_LT((q - (p(1.3) + 0.03 * v(1.3))).norm(), 1e-12);
-  EXPECT_FALSE(h.StateAt(1.4, 0.35, 0.05, &q, &w));
-  EXPECT_FALSE(OdometryHistory().StateAt(1.0, 1.0, 1.0, &q, &w));
+  EXPECT_FALSE(h.StateAt(ToNanoseconds(1.4), 0.35, 0.05, &q, &w));
+  EXPECT_FALSE(OdometryHistory().StateAt(ToNanoseconds(1.0), 1.0, 1.0, &q, &w));
 }
 
 TEST(OdometryHistory, AttitudeOfTheNearestMessage) {
   OdometryHistory h;
   Eigen::Quaterniond q;
-  EXPECT_FALSE(h.AttitudeAt(1.0, 0.5, &q));
+  EXPECT_FALSE(h.AttitudeAt(ToNanoseconds(1.0), 0.5, &q));
   TeammateOdometry a = Message(1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   TeammateOdometry b = Message(2.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   b.q_Gj_bj = Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
   h.Add(a, 10.0);
   h.Add(b, 10.0);
-  ASSERT_TRUE(h.AttitudeAt(1.4, 0.5, &q));
+  ASSERT_TRUE(h.AttitudeAt(ToNanoseconds(1.4), 0.5, &q));
   EXPECT_TRUE(q.isApprox(a.q_Gj_bj));
-  ASSERT_TRUE(h.AttitudeAt(1.6, 0.5, &q));
+  ASSERT_TRUE(h.AttitudeAt(ToNanoseconds(1.6), 0.5, &q));
   EXPECT_TRUE(q.isApprox(b.q_Gj_bj));
-  ASSERT_TRUE(h.AttitudeAt(2.4, 0.5, &q));
+  ASSERT_TRUE(h.AttitudeAt(ToNanoseconds(2.4), 0.5, &q));
   EXPECT_TRUE(q.isApprox(b.q_Gj_bj));
-  EXPECT_FALSE(h.AttitudeAt(2.6, 0.5, &q));  // too old
-  EXPECT_FALSE(h.AttitudeAt(0.4, 0.5, &q));
+  EXPECT_FALSE(h.AttitudeAt(ToNanoseconds(2.6), 0.5, &q));  // too old
+  EXPECT_FALSE(h.AttitudeAt(ToNanoseconds(0.4), 0.5, &q));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // teammate flies an excited pattern and is seen through its tape, a second
 // teammate broadcasts but is never seen, and a static reflective decoy sits
 // in view.
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/teammate_detector.h"
 
 #include <gtest/gtest.h>
@@ -55,7 +56,7 @@ struct World {
 TeammateOdometry Broadcast(int id, double t, const Eigen::Isometry3d& T_W_G, const Eigen::Vector3d& p_W,
                            const Eigen::Vector3d& v_W) {
   TeammateOdometry m;
-  m.stamp_s = 500.0 + t;
+  m.stamp_ns = ToNanoseconds(500.0 + t);
   m.drone_id = id;
   m.p_bj_in_Gj = T_W_G.inverse() * p_W;
   m.v_bj_in_Gj = T_W_G.linear().transpose() * v_W;
@@ -91,7 +92,7 @@ TEST(TeammateDetector, IdentifiesTracksAndObservesATeammateAmongDecoys) {
     AddBlob(T_bi_W * world.decoy_in_W, Eigen::Vector3d(0.05, 0.05, 0.05), 20, 240.f, &rng, &points);
 
     const Eigen::Isometry3d T_Gi_bi = world.T_W_Gi.inverse() * world.T_W_bi(t);
-    ASSERT_TRUE(detector.ProcessScan(500.0 + t, T_Gi_bi, points, &result).ok());
+    ASSERT_TRUE(detector.ProcessScan(ToNanoseconds(500.0 + t), T_Gi_bi, points, &result).ok());
 
     for (const TeammateIdentification& id : result.identifications) {
       ASSERT_EQ(id.drone_id, 1) << "false identification";
@@ -150,7 +151,7 @@ TEST(TeammateDetector, TrackerFollowsOdometryWhenNotSeenAndAcceptsARefinedExtrin
       AddBlob(c - 0.07 * c.normalized(), Eigen::Vector3d(0.03, 0.08, 0.025), 25, 230.f, &rng, &points);
     }
     const Eigen::Isometry3d T_Gi_bi = world.T_W_Gi.inverse() * world.T_W_bi(t);
-    ASSERT_TRUE(detector.ProcessScan(500.0 + t, T_Gi_bi, points, &result).ok());
+    ASSERT_TRUE(detector.ProcessScan(ToNanoseconds(500.0 + t), T_Gi_bi, points, &result).ok());
     if (!visible) {
       EXPECT_TRUE(result.observations.empty());
       ASSERT_EQ(result.trackers.size(), 1u);
@@ -188,7 +189,7 @@ int ScansToReidentify(bool restart, Eigen::Isometry3d* T_Gi_Gj_new) {
     if (k == kReboot + 1) {
       EXPECT_EQ(detector.IdentifiedTeammates(), std::vector<int>{1});
       if (restart) {
-        EXPECT_TRUE(detector.RestartTeammate(1, 500.0 + t));
+        EXPECT_TRUE(detector.RestartTeammate(1, ToNanoseconds(500.0 + t)));
         EXPECT_EQ(detector.num_temporary_trackers(), 1);
       } else {
         EXPECT_TRUE(detector.ForgetTeammate(1));
@@ -202,7 +203,7 @@ int ScansToReidentify(bool restart, Eigen::Isometry3d* T_Gi_Gj_new) {
     AddBlob(c - 0.07 * c.normalized(), Eigen::Vector3d(0.03, 0.08, 0.025), 25, 230.f, &rng,
             &points);
     const Eigen::Isometry3d T_Gi_bi = world.T_W_Gi.inverse() * world.T_W_bi(t);
-    EXPECT_TRUE(detector.ProcessScan(500.0 + t, T_Gi_bi, points, &result).ok());
+    EXPECT_TRUE(detector.ProcessScan(ToNanoseconds(500.0 + t), T_Gi_bi, points, &result).ok());
     if (rebooted && identified_at < 0 && !result.identifications.empty()) {
       identified_at = k - kReboot;
       const TeammateIdentification& id = result.identifications[0];

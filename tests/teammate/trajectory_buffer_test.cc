@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/trajectory_buffer.h"
 
 #include <gtest/gtest.h>
@@ -9,9 +10,9 @@ namespace {
 
 TEST(TrajectoryBuffer, KeepsTheLastPositions) {
   TrajectoryBuffer buffer(5);
-  for (int k = 0; k < 8; ++k) buffer.Push(k, Eigen::Vector3d(k, 0, 0));
+  for (int k = 0; k < 8; ++k) buffer.Push(ToNanoseconds(k), Eigen::Vector3d(k, 0, 0));
   ASSERT_EQ(buffer.size(), 5);
-  EXPECT_EQ(buffer.samples().front().stamp_s, 3.0);
+  EXPECT_EQ(buffer.samples().front().stamp_ns, ToNanoseconds(3.0));
   EXPECT_EQ(buffer.samples().back().p.x(), 7.0);
 }
 
@@ -34,8 +35,8 @@ TEST(Excitation, AStraightLineIsNotExcitedACurveIs) {
   const Eigen::Vector3d direction = Eigen::Vector3d(1, 2, 0.5).normalized();
   for (int k = 0; k < 200; ++k) {
     const double t = 0.1 * k;
-    line.Push(t, Eigen::Vector3d(1, 1, 1) + direction * std::sin(0.5 * t) * 2.0);
-    curve.Push(t, Eigen::Vector3d(std::cos(0.5 * t), std::sin(0.5 * t), 0.1 * std::sin(t)));
+    line.Push(ToNanoseconds(t), Eigen::Vector3d(1, 1, 1) + direction * std::sin(0.5 * t) * 2.0);
+    curve.Push(ToNanoseconds(t), Eigen::Vector3d(std::cos(0.5 * t), std::sin(0.5 * t), 0.1 * std::sin(t)));
   }
   EXPECT_LT(line.ScatterSingularValues()(1), 1e-9);
   EXPECT_FALSE(IsExcited(line, options));
@@ -50,7 +51,7 @@ TEST(Excitation, NeedsEnoughPositions) {
   options.min_second_singular_value_m2 = 0.1;
   TrajectoryBuffer buffer(300);
   for (int k = 0; k < 29; ++k) {
-    buffer.Push(k, Eigen::Vector3d(std::cos(k), std::sin(k), 0) * 3.0);
+    buffer.Push(ToNanoseconds(k), Eigen::Vector3d(std::cos(k), std::sin(k), 0) * 3.0);
   }
   EXPECT_FALSE(IsExcited(buffer, options));
   buffer.Push(29, Eigen::Vector3d(3, 0, 0));

@@ -1,3 +1,4 @@
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/trajectory_matcher.h"
 
 #include <gtest/gtest.h>
@@ -42,7 +43,7 @@ Scenario Make(double drop, double noise_m, double outliers, uint64_t seed) {
     const double t = 100.0 + 0.1 * k;
     if (u(rng) < drop) continue;
     TeammateOdometry m;
-    m.stamp_s = t;
+    m.stamp_ns = ToNanoseconds(t);
     m.drone_id = 3;
     m.p_bj_in_Gj = TeammatePosition(t - 100.0);
     m.v_bj_in_Gj = TeammateVelocity(t - 100.0);
@@ -53,7 +54,7 @@ Scenario Make(double drop, double noise_m, double outliers, uint64_t seed) {
     Eigen::Vector3d p = s.R_Gi_Gj * TeammatePosition(t - 100.0) + s.p_Gj_in_Gi;
     p += Eigen::Vector3d(n(rng), n(rng), n(rng));
     if (u(rng) < outliers) p += Eigen::Vector3d(0.8, -0.5, 0.2);
-    s.tracker.Push(t, p);
+    s.tracker.Push(ToNanoseconds(t), p);
   }
   return s;
 }
@@ -91,7 +92,7 @@ TEST(MatchTrajectory, LongGapsRemovePairs) {
   Scenario s = Make(0.0, 0.0, 0.0, 3);
   OdometryHistory gappy;
   for (const TeammateOdometry& m : s.teammate.messages()) {
-    if (m.stamp_s > 105.0 && m.stamp_s < 110.0) continue;  // 5 s without messages
+    if (m.stamp_ns > ToNanoseconds(105.0) && m.stamp_ns < ToNanoseconds(110.0)) continue;  // 5 s without messages
     gappy.Add(m, 60.0);
   }
   MatchingOptions options;
@@ -117,11 +118,11 @@ TEST(MatchTrajectory, RefusesAStraightTeammateTrajectory) {
   TrajectoryBuffer tracker(300);
   for (int k = 0; k < 100; ++k) {
     TeammateOdometry m;
-    m.stamp_s = 0.1 * k;
+    m.stamp_ns = ToNanoseconds(0.1 * k);
     m.p_bj_in_Gj = Eigen::Vector3d(0.1 * k, 0.05 * k, 1.0);
     m.v_bj_in_Gj = Eigen::Vector3d(1.0, 0.5, 0.0);
     line.Add(m, 60.0);
-    tracker.Push(m.stamp_s, m.p_bj_in_Gj + Eigen::Vector3d(1, 2, 3));
+    tracker.Push(m.stamp_ns, m.p_bj_in_Gj + Eigen::Vector3d(1, 2, 3));
   }
   TrajectoryMatch match;
   const Status status = MatchTrajectory(tracker, line, MatchingOptions(), &match);
@@ -135,7 +136,7 @@ TEST(MatchTrajectory, AWrongTeammateHasALargeResidual) {
   OdometryHistory other;
   for (int k = 0; k <= 250; ++k) {
     TeammateOdometry m;
-    m.stamp_s = 100.0 + 0.1 * k;
+    m.stamp_ns = ToNanoseconds(100.0 + 0.1 * k);
     const double t = 0.1 * k;
     m.p_bj_in_Gj = Eigen::Vector3d(std::cos(0.9 * t), 0.8 * std::sin(0.6 * t), 1 + 0.1 * std::sin(t));
     m.v_bj_in_Gj = Eigen::Vector3d(-0.9 * std::sin(0.9 * t), 0.48 * std::cos(0.6 * t), 0.1 * std::cos(t));

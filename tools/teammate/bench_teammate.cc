@@ -72,7 +72,7 @@ const Recording& GetRecording(int which = 0) {
 
 void Feed(TeammateDetector* detector, const harness::PreparedScan& scan, ScanResult* result) {
   for (const TeammateOdometry& m : scan.odometry) detector->AddTeammateOdometry(m);
-  (void)detector->ProcessScan(scan.stamp_s, scan.T_Gi_bi, scan.points, result);
+  (void)detector->ProcessScan(scan.stamp_ns, scan.T_Gi_bi, scan.points, result);
 }
 
 double Quantile(std::vector<double> v, double q) {
@@ -97,7 +97,7 @@ void BM_ProcessScan(benchmark::State& state) {
     const harness::PreparedScan& scan = rec.scans[cursor++];
     for (const TeammateOdometry& m : scan.odometry) detector->AddTeammateOdometry(m);
     const auto start = std::chrono::steady_clock::now();
-    const Status status = detector->ProcessScan(scan.stamp_s, scan.T_Gi_bi, scan.points, &result);
+    const Status status = detector->ProcessScan(scan.stamp_ns, scan.T_Gi_bi, scan.points, &result);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     benchmark::DoNotOptimize(status.ok());

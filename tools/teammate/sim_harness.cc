@@ -50,7 +50,7 @@ std::vector<Delivery> MakeBroadcasts(const sim::Simulator& sim, int observer,
       delivery.arrival_true_s = t + options.latency_s;
       TeammateOdometry& m = delivery.odometry;
       m.drone_id = j;
-      m.stamp_s = StampSeconds(sim.StampNs(observer, t));
+      m.stamp_ns = sim.StampNs(observer, t);
       if (options.ego_estimates != nullptr) {
         EgoEstimate s;
         if (!(*options.ego_estimates)[static_cast<size_t>(j)].StateAt(sim.StampNs(j, t), &s)) {
@@ -119,7 +119,7 @@ class HarnessSink : public sim::DroneSink {
     T_bend_bk_.resize(static_cast<size_t>(num_samples));
     for (int k = 0; k < num_samples; ++k) {
       const int64_t stamp_ns =
-          std::min<int64_t>(scan.stamp_ns + std::llround(k * dt * 1e9), record_time_ns);
+          std::min<int64_t>(scan.stamp_ns + ToNanoseconds(k * dt), record_time_ns);
       Eigen::Isometry3d T_F_bk;
       if (!PoseAt(t_start + k * dt, stamp_ns, &T_F_bk)) {
         ++scans_without_pose_;  // the frame began before the first estimate
@@ -129,7 +129,7 @@ class HarnessSink : public sim::DroneSink {
     }
     PreparedScan& out = prepared_;
     out.observer = observer_;
-    out.stamp_s = StampSeconds(record_time_ns);
+    out.stamp_ns = record_time_ns;
     out.t_true_s = t_end;
     out.T_Gi_bi = T_Gi_F_ * T_F_bend;
     out.points.resize(scan.points.size());
@@ -243,7 +243,7 @@ bool EstimatedTrajectory::StateAt(int64_t stamp_ns, EgoEstimate* state) const {
       [](const EgoEstimate& s, int64_t stamp) { return s.stamp_ns < stamp; });
   if (after == states.end()) {
     *state = states.back();
-    state->p_b_in_G += StampSeconds(stamp_ns - state->stamp_ns) * state->v_b_in_G;
+    state->p_b_in_G += SecondsBetween(state->stamp_ns, stamp_ns) * state->v_b_in_G;
   } else if (after->stamp_ns == stamp_ns) {
     *state = *after;
   } else {
@@ -373,7 +373,7 @@ Status EvaluateObserver(const sim::Simulator& sim, int observer,
   const ScanCallback callback = [&](const PreparedScan& scan) -> Status {
     for (const TeammateOdometry& m : scan.odometry) detector.AddTeammateOdometry(m);
     const auto start = std::chrono::steady_clock::now();
-    SWARMLIO_RETURN_IF_ERROR(detector.ProcessScan(scan.stamp_s, scan.T_Gi_bi, scan.points, &result));
+    SWARMLIO_RETURN_IF_ERROR(detector.ProcessScan(scan.stamp_ns, scan.T_Gi_bi, scan.points, &result));
     report->process_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     report->scan_sizes.push_back(static_cast<int>(scan.points.size()));

@@ -88,7 +88,7 @@ struct HarnessOptions {
 /// One scan ready for TeammateDetector::ProcessScan.
 struct PreparedScan {
   int observer = 0;
-  double stamp_s = 0.0;   // observer clock, scan end
+  int64_t stamp_ns = 0;   // observer clock, scan end
   double t_true_s = 0.0;  // true time of the scan end
   Eigen::Isometry3d T_Gi_bi = Eigen::Isometry3d::Identity();  // ego pose at the scan end
   std::vector<ScanPoint> points;

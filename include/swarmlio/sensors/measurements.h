@@ -1,6 +1,7 @@
 // Raw sensor records as they come from a log or the simulator, before any
 // estimator processing. Time stamps are integer nanoseconds so that logs
-// round-trip bit for bit; StampSeconds() gives the double for computation.
+// round-trip bit for bit; ToSeconds() (common/time.h) gives the double for
+// computation.
 //
 // Frames: IMU samples are in the IMU frame; LiDAR points are in the LiDAR
 // frame; a ground-truth pose is the IMU (body) frame b in a global frame G.
@@ -12,11 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/common/time.h"
+
 namespace swarmlio {
 
-/// Correctly rounded (division, not multiplication by 1e-9), so every module
-/// converting nanoseconds this way gets bit-identical seconds.
-inline double StampSeconds(int64_t stamp_ns) { return static_cast<double>(stamp_ns) / 1e9; }
+/// The name of ToSeconds() older code uses (common/time.h); identical.
+inline double StampSeconds(int64_t stamp_ns) { return ToSeconds(stamp_ns); }
 
 /// One IMU sample. Acceleration is the specific force as the device reports
 /// it (m/s^2 for most IMUs, g for Livox built-in IMUs; the estimator's IMU

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "swarmlio/common/time.h"
 #include "swarmlio/common/option_fields.h"
 
 namespace swarmlio::teammate {
@@ -42,31 +43,31 @@ class ConstantVelocityFilter {
   using Vector6d = Eigen::Matrix<double, 6, 1>;
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
-  /// Starts at `p_in_G` with velocity `v_in_G` at time `stamp_s`.
-  void Initialize(double stamp_s, const Eigen::Vector3d& p_in_G, const Eigen::Vector3d& v_in_G,
+  /// Starts at `p_in_G` with velocity `v_in_G` at time `stamp_ns`.
+  void Initialize(int64_t stamp_ns, const Eigen::Vector3d& p_in_G, const Eigen::Vector3d& v_in_G,
                   double position_sigma_m, double velocity_sigma_m_s);
 
-  /// Moves the state to `stamp_s` (dt may be negative; Q uses |dt|).
-  void PredictTo(double stamp_s, double accel_noise_density_m_s2_sqrt_hz);
+  /// Moves the state to `stamp_ns` (dt may be negative; Q uses |dt|).
+  void PredictTo(int64_t stamp_ns, double accel_noise_density_m_s2_sqrt_hz);
   /// Same, with the velocity replaced by a known one (teammate trackers:
   /// the velocity the teammate broadcasts): p' = p + v dt, Q on p only.
-  void PredictWithVelocity(double stamp_s, const Eigen::Vector3d& v_in_G,
+  void PredictWithVelocity(int64_t stamp_ns, const Eigen::Vector3d& v_in_G,
                            double velocity_sigma_m_s);
 
   /// Position update; returns the squared Mahalanobis distance of the innovation.
   double Update(const Eigen::Vector3d& z_in_G, const Eigen::Matrix3d& R);
 
-  /// Extrapolated position at `stamp_s` (state unchanged).
-  Eigen::Vector3d PositionAt(double stamp_s) const { return p() + v() * (stamp_s - stamp_s_); }
+  /// Extrapolated position at `stamp_ns` (state unchanged).
+  Eigen::Vector3d PositionAt(int64_t stamp_ns) const { return p() + v() * SecondsBetween(stamp_ns_, stamp_ns); }
 
-  double stamp_s() const { return stamp_s_; }
+  int64_t stamp_ns() const { return stamp_ns_; }
   Eigen::Vector3d p() const { return x_.head<3>(); }
   Eigen::Vector3d v() const { return x_.tail<3>(); }
   const Vector6d& x() const { return x_; }
   const Matrix6d& P() const { return P_; }
 
  private:
-  double stamp_s_ = 0.0;
+  int64_t stamp_ns_ = 0;
   Vector6d x_ = Vector6d::Zero();
   Matrix6d P_ = Matrix6d::Identity();
 };

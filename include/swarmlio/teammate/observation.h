@@ -89,7 +89,7 @@ struct ObservationOptions {
 /// ^{b_i}p_{b_j} with its covariance, at the scan stamp.
 struct TeammateObservation {
   int drone_id = -1;
-  double stamp_s = 0.0;  // the scan stamp: time of p_bj_in_bi and of the body frame b_i
+  int64_t stamp_ns = 0;  // the scan stamp: time of p_bj_in_bi and of the body frame b_i
   Eigen::Vector3d p_bj_in_bi = Eigen::Vector3d::Zero();
   Eigen::Matrix3d covariance_m2 = Eigen::Matrix3d::Identity();
   int num_points = 0;              // points in the cluster
@@ -113,9 +113,9 @@ ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptio
 /// observer); see the file comment.
 Eigen::Vector3d TapeCentroidInBody(const Eigen::Vector3d& u_in_bj, double a, double b);
 
-/// Builds the observation of `cluster` (in b_i at `stamp_s`). `v_bj_in_bi`:
+/// Builds the observation of `cluster` (in b_i at `stamp_ns`). `v_bj_in_bi`:
 /// the teammate's velocity (in G_i) rotated into b_i, for the time correction.
-TeammateObservation MakeObservation(int drone_id, double stamp_s, const PointCluster& cluster,
+TeammateObservation MakeObservation(int drone_id, int64_t stamp_ns, const PointCluster& cluster,
                                     const Eigen::Vector3d& v_bj_in_bi,
                                     const ObservationOptions& options,
                                     const Eigen::Matrix3d* R_bi_bj = nullptr);

@@ -25,17 +25,17 @@ class OdometryHistory {
   const TeammateOdometry& newest() const { return messages_.back(); }
   const std::deque<TeammateOdometry>& messages() const { return messages_; }
 
-  /// Position and velocity of the teammate (in its G_j) at `stamp_s`; false
+  /// Position and velocity of the teammate (in its G_j) at `stamp_ns`; false
   /// when no message is close enough (see the file comment).
-  bool StateAt(double stamp_s, double max_gap_s, double max_extrapolation_s,
+  bool StateAt(int64_t stamp_ns, double max_gap_s, double max_extrapolation_s,
                Eigen::Vector3d* p_bj_in_Gj, Eigen::Vector3d* v_bj_in_Gj) const;
-  /// Attitude R_Gj_bj of the message nearest to `stamp_s`; false when none is
+  /// Attitude R_Gj_bj of the message nearest to `stamp_ns`; false when none is
   /// within `max_age_s`.
-  bool AttitudeAt(double stamp_s, double max_age_s, Eigen::Quaterniond* q_Gj_bj) const;
+  bool AttitudeAt(int64_t stamp_ns, double max_age_s, Eigen::Quaterniond* q_Gj_bj) const;
 
  private:
-  // The message nearest to `stamp_s` (ties: the later one); null when empty.
-  const TeammateOdometry* Nearest(double stamp_s) const;
+  // The message nearest to `stamp_ns` (ties: the later one); null when empty.
+  const TeammateOdometry* Nearest(int64_t stamp_ns) const;
 
   std::deque<TeammateOdometry> messages_;  // sorted by stamp
 };

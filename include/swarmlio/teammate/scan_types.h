@@ -40,7 +40,7 @@ struct PointCluster {
 /// global frame G_j). The stamp must already be in the receiver's clock
 /// (the network layer corrects the clock offset; docs/teammate.md).
 struct TeammateOdometry {
-  double stamp_s = 0.0;
+  int64_t stamp_ns = 0;
   int drone_id = -1;
   Eigen::Vector3d p_bj_in_Gj = Eigen::Vector3d::Zero();   // [m]
   Eigen::Quaterniond q_Gj_bj = Eigen::Quaterniond::Identity();

@@ -28,6 +28,7 @@
 #include <memory>
 #include <vector>
 
+#include "swarmlio/common/time.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/teammate/clustering.h"
 #include "swarmlio/teammate/observation.h"
@@ -44,7 +45,7 @@ namespace swarmlio::teammate {
 struct TeammateIdentification {
   int drone_id = -1;
   int tracker_id = -1;
-  double stamp_s = 0.0;
+  int64_t stamp_ns = 0;
   Eigen::Matrix3d R_Gi_Gj = Eigen::Matrix3d::Identity();  // initial global extrinsic
   Eigen::Vector3d p_Gj_in_Gi = Eigen::Vector3d::Zero();
   double mean_residual_m = 0.0;
@@ -93,10 +94,10 @@ class TeammateDetector {
   /// Stores a teammate's broadcast (stamp in this drone's clock).
   void AddTeammateOdometry(const TeammateOdometry& odometry);
 
-  /// Processes one scan. `stamp_s`: the time of the points' body frame and of
+  /// Processes one scan. `stamp_ns`: the time of the points' body frame and of
   /// `T_Gi_bi` (the scan end after motion compensation). Errors: non-finite
   /// pose or stamp.
-  Status ProcessScan(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+  Status ProcessScan(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                      const std::vector<ScanPoint>& points, ScanResult* result);
 
   /// Ids of the identified teammates, ascending.
@@ -109,8 +110,8 @@ class TeammateDetector {
   /// this drone's trajectory and sent its T_Gj_Gi; docs/swarm.md "Mutual
   /// identification"): a teammate tracker at its broadcast position mapped
   /// through T_Gi_Gj. False when already tracked or when no broadcast of it
-  /// is close enough to `stamp_s`.
-  bool AddIdentifiedTeammate(int drone_id, double stamp_s, const Eigen::Matrix3d& R_Gi_Gj,
+  /// is close enough to `stamp_ns`.
+  bool AddIdentifiedTeammate(int drone_id, int64_t stamp_ns, const Eigen::Matrix3d& R_Gi_Gj,
                              const Eigen::Vector3d& p_Gj_in_Gi);
   /// Forgets a teammate (its tracker and broadcast history), e.g. after it
   /// rebooted (new global frame) or was lost for good; it can be identified
@@ -119,26 +120,26 @@ class TeammateDetector {
   /// The teammate rebooted (new G_j): as ForgetTeammate, but its tracker's
   /// track goes on as a temporary tracker with the positions it saw (G_i
   /// did not change), so the new session is matched as soon as it has
-  /// enough pairs, without a new excitation. `stamp_s`: now (own clock).
-  bool RestartTeammate(int drone_id, double stamp_s);
+  /// enough pairs, without a new excitation. `stamp_ns`: now (own clock).
+  bool RestartTeammate(int drone_id, int64_t stamp_ns);
 
   int num_temporary_trackers() const { return static_cast<int>(temporary_.size()); }
   const std::vector<TemporaryTracker>& temporary_trackers() const { return temporary_; }
   const TeammateDetectorOptions& options() const { return options_; }
 
  private:
-  void TrackTeammates(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+  void TrackTeammates(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                       const std::vector<ScanPoint>& points, std::vector<bool>* available,
                       ScanResult* result);
-  void TrackTemporary(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+  void TrackTemporary(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                       const std::vector<ScanPoint>& points, std::vector<bool>* available,
                       ScanResult* result);
-  void StartTrackers(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+  void StartTrackers(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                      const std::vector<bool>& available);
-  void Identify(double stamp_s, ScanResult* result);
+  void Identify(int64_t stamp_ns, ScanResult* result);
   // Drops the temporary trackers k with remove[k] (keeps the others' order).
   void RemoveTemporary(const std::vector<bool>& remove);
-  void FillOutputs(double stamp_s, const Eigen::Isometry3d& T_Gi_bi,
+  void FillOutputs(int64_t stamp_ns, const Eigen::Isometry3d& T_Gi_bi,
                    const std::vector<ScanPoint>& points, ScanResult* result);
   // A cluster in the predicted region around `center_in_b`, drone-sized and
   // within `gate_m` of the centre.
@@ -153,7 +154,6 @@ class TeammateDetector {
   std::vector<TemporaryTracker> temporary_;
   std::map<int, TeammateTracker> teammates_;  // by drone id
   int next_tracker_id_ = 0;
-  double last_stamp_s_ = -1e300;
   // Per-scan scratch.
   std::vector<PointCluster> clusters_;
   std::vector<bool> seen_temporary_;

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "swarmlio/common/time.h"
 #include "swarmlio/common/option_fields.h"
 #include "swarmlio/teammate/cv_filter.h"
 #include "swarmlio/teammate/odometry_history.h"
@@ -67,27 +68,26 @@ class TeammateTracker {
     p_Gj_in_Gi_ = p_Gj_in_Gi;
   }
 
-  /// The teammate's velocity in G_i at `stamp_s` from its broadcasts (the
+  /// The teammate's velocity in G_i at `stamp_ns` from its broadcasts (the
   /// newest one while connected); false when disconnected.
-  bool VelocityInGi(double stamp_s, const OdometryHistory& history,
+  bool VelocityInGi(int64_t stamp_ns, const OdometryHistory& history,
                     const TeammateTrackerOptions& options, Eigen::Vector3d* v_in_Gi) const;
 
-  /// Moves the filter to `stamp_s` with the broadcast velocity.
-  void Predict(double stamp_s, const OdometryHistory& history, const TeammateTrackerOptions& options);
-  /// Predicted position at `stamp_s` (state unchanged).
-  Eigen::Vector3d PositionAt(double stamp_s, const OdometryHistory& history,
+  /// Moves the filter to `stamp_ns` with the broadcast velocity.
+  void Predict(int64_t stamp_ns, const OdometryHistory& history, const TeammateTrackerOptions& options);
+  /// Predicted position at `stamp_ns` (state unchanged).
+  Eigen::Vector3d PositionAt(int64_t stamp_ns, const OdometryHistory& history,
                              const TeammateTrackerOptions& options) const;
 
-  /// LiDAR update with a cluster position measured at `stamp_s`.
-  void UpdateLidar(double stamp_s, const Eigen::Vector3d& p_in_Gi, const OdometryHistory& history,
+  /// LiDAR update with a cluster position measured at `stamp_ns`.
+  void UpdateLidar(int64_t stamp_ns, const Eigen::Vector3d& p_in_Gi, const OdometryHistory& history,
                    const TeammateTrackerOptions& options);
-  /// Update with the broadcast position at `stamp_s` mapped into G_i; false
+  /// Update with the broadcast position at `stamp_ns` mapped into G_i; false
   /// (no update, prediction only) when the broadcast is stale.
-  bool UpdateOdometry(double stamp_s, const OdometryHistory& history,
+  bool UpdateOdometry(int64_t stamp_ns, const OdometryHistory& history,
                       const TeammateTrackerOptions& options);
 
   const ConstantVelocityFilter& filter() const { return filter_; }
-  double last_lidar_update_s() const { return last_lidar_update_s_; }
   /// The cluster positions of its LiDAR updates (G_i, newest last): when
   /// the teammate restarts, a temporary tracker continues with them.
   const TrajectoryBuffer& seen_trajectory() const { return seen_; }
@@ -98,7 +98,6 @@ class TeammateTracker {
   Eigen::Matrix3d R_Gi_Gj_;
   Eigen::Vector3d p_Gj_in_Gi_;
   ConstantVelocityFilter filter_;
-  double last_lidar_update_s_ = -1e300;
   TrajectoryBuffer seen_;
 };
 

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "swarmlio/common/time.h"
 #include "swarmlio/common/option_fields.h"
 #include "swarmlio/teammate/cv_filter.h"
 #include "swarmlio/teammate/trajectory_buffer.h"
@@ -32,39 +33,44 @@ struct TemporaryTrackerOptions {
 
 class TemporaryTracker {
  public:
-  /// Starts on a detection at `p_in_G`, measured at `stamp_s`.
-  TemporaryTracker(int id, double stamp_s, const Eigen::Vector3d& p_in_G,
+  /// Starts on a detection at `p_in_G`, measured at `stamp_ns`.
+  TemporaryTracker(int id, int64_t stamp_ns, const Eigen::Vector3d& p_in_G,
                    const TemporaryTrackerOptions& options, int trajectory_capacity);
 
   /// Continues the track of a teammate tracker whose teammate restarted
   /// (TeammateDetector::RestartTeammate): its filter and the positions it
-  /// saw, at `stamp_s`.
-  TemporaryTracker(int id, double stamp_s, const ConstantVelocityFilter& filter,
+  /// saw, at `stamp_ns`.
+  TemporaryTracker(int id, int64_t stamp_ns, const ConstantVelocityFilter& filter,
                    const TrajectoryBuffer& trajectory);
 
   /// Predicts to the measurement time and updates with a cluster position;
   /// the updated position joins the trajectory.
-  void Update(double stamp_s, const Eigen::Vector3d& p_in_G, const TemporaryTrackerOptions& options);
+  void Update(int64_t stamp_ns, const Eigen::Vector3d& p_in_G, const TemporaryTrackerOptions& options);
 
-  /// Predicted position at `stamp_s` (state unchanged).
-  Eigen::Vector3d PositionAt(double stamp_s) const { return filter_.PositionAt(stamp_s); }
-  bool Expired(double stamp_s, const TemporaryTrackerOptions& options) const {
-    return stamp_s - last_update_s_ > options.max_coast_s;
+  /// Predicted position at `stamp_ns` (state unchanged).
+  Eigen::Vector3d PositionAt(int64_t stamp_ns) const { return filter_.PositionAt(stamp_ns); }
+  bool Expired(int64_t stamp_ns, const TemporaryTrackerOptions& options) const {
+    return SecondsBetween(last_update_ns_, stamp_ns) > options.max_coast_s;
   }
 
   int id() const { return id_; }
-  double created_s() const { return created_s_; }
-  double last_update_s() const { return last_update_s_; }
-  double last_match_s() const { return last_match_s_; }
-  void set_last_match_s(double stamp_s) { last_match_s_ = stamp_s; }
+  int64_t created_ns() const { return created_ns_; }
+  int64_t last_update_ns() const { return last_update_ns_; }
+  int64_t last_match_ns() const { return last_match_ns_; }
+  bool matched_before() const { return matched_before_; }
+  void set_last_match_ns(int64_t stamp_ns) {
+    last_match_ns_ = stamp_ns;
+    matched_before_ = true;
+  }
   const ConstantVelocityFilter& filter() const { return filter_; }
   const TrajectoryBuffer& trajectory() const { return trajectory_; }
 
  private:
   int id_;
-  double created_s_;
-  double last_update_s_;
-  double last_match_s_ = -1e300;
+  int64_t created_ns_;
+  int64_t last_update_ns_;
+  int64_t last_match_ns_ = 0;  // valid when matched_before_
+  bool matched_before_ = false;
   ConstantVelocityFilter filter_;
   TrajectoryBuffer trajectory_;
 };

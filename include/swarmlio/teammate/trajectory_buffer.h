@@ -21,7 +21,7 @@
 namespace swarmlio::teammate {
 
 struct StampedPosition {
-  double stamp_s = 0.0;
+  int64_t stamp_ns = 0;
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
 };
 
@@ -57,7 +57,7 @@ class TrajectoryBuffer {
   explicit TrajectoryBuffer(int capacity = 300) : capacity_(capacity) {}
 
   /// Appends; drops the oldest beyond the capacity.
-  void Push(double stamp_s, const Eigen::Vector3d& p);
+  void Push(int64_t stamp_ns, const Eigen::Vector3d& p);
   void Clear() { samples_.clear(); }
 
   int size() const { return static_cast<int>(samples_.size()); }
