@@ -16,6 +16,7 @@
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/net/message_channel.h"
 #include "swarmlio/net/simulated_network.h"
+#include "swarmlio/net/clock_sync_simulation.h"
 #include "tests/net/net_test_util.h"
 
 namespace swarmlio::net {
@@ -24,172 +25,31 @@ namespace {
 constexpr int64_t kMs = 1'000'000;
 constexpr int64_t kS = 1'000'000'000;
 
-/// A drone's clock: local = epoch + t + drift * t, t = true time since the
-/// simulation start [ns].
-struct DroneClock {
-  int64_t epoch_ns = 0;
-  double drift = 0.0;  // rate error, 20e-6 = 20 ppm
+using CaseFigures = ClockSyncFigures;
 
-  int64_t Local(int64_t true_ns) const {
-    return epoch_ns + true_ns + std::llround(drift * static_cast<double>(true_ns));
-  }
-  /// The first true time at which the local clock reads >= local_ns.
-  int64_t TrueAt(int64_t local_ns) const {
-    int64_t t = std::llround(static_cast<double>(local_ns - epoch_ns) / (1.0 + drift));
-    while (Local(t) < local_ns) ++t;
-    while (Local(t - 1) >= local_ns) --t;
-    return t;
-  }
-};
-
-/// N drones that run ClockSync over MessageChannels on a SimulatedNetwork,
-/// event by event: request times, arrivals and replies (after a turnaround);
-/// with exchange = state_echo, each drone broadcasts a state every 100 ms of
-/// its clock, sent `turnaround_ns` after its stamp (the processing time).
+/// The simulation of swarmlio/net/clock_sync_simulation.h, failing the test
+/// on any error.
 class SyncSimulation {
  public:
-  static constexpr int64_t kStatePeriodNs = 100 * kMs;
-
-  SyncSimulation(const NetworkOptions& network_options,
-                 std::vector<DroneClock> clocks,
-                 const ClockSyncOptions& sync_options,
-                 int64_t turnaround_ns = 1 * kMs)
-      : clocks_(std::move(clocks)), turnaround_ns_(turnaround_ns), codec_(net_test::MakeCodec()),
-        states_(sync_options.exchange == ClockExchange::kStateEcho) {
-    std::vector<int> ids;
-    for (size_t i = 0; i < clocks_.size(); ++i) ids.push_back(static_cast<int>(i));
-    const Status s = SimulatedNetwork::Create(network_options, ids, &network_);
+  SyncSimulation(const NetworkOptions& network_options, std::vector<SimulatedClock> clocks,
+                 const ClockSyncOptions& sync_options) {
+    const Status s = ClockSyncSimulation::Create(network_options, std::move(clocks),
+                                                      sync_options, 1 * kMs, &sim_);
     EXPECT_TRUE(s.ok()) << s.message();
-    for (int id : ids) {
-      channels_.emplace_back(&codec_, network_->Endpoint(id));
-      std::unique_ptr<ClockSync> sync;
-      EXPECT_TRUE(ClockSync::Create(id, sync_options, &sync).ok());
-      for (int other : ids) sync->AddTeammate(other, clocks_[id].Local(0));
-      syncs_.push_back(std::move(sync));
-      // The first state at a whole period of the drone's clock.
-      const int64_t first = clocks_[id].Local(0);
-      next_state_ns_.push_back(first + (kStatePeriodNs - first % kStatePeriodNs) % kStatePeriodNs);
-    }
   }
-
-  /// Runs every event up to true time `end_ns`.
   void RunUntil(int64_t end_ns) {
-    std::vector<TimeSyncMessage> requests;
-    std::vector<ReceivedMessage> inbox;
-    for (;;) {
-      int64_t t = network_->NextArrivalNs();
-      for (size_t i = 0; i < syncs_.size(); ++i) {
-        const int64_t next = states_ ? next_state_ns_[i] : syncs_[i]->NextRequestNs();
-        if (next != std::numeric_limits<int64_t>::max()) t = std::min(t, clocks_[i].TrueAt(next));
-      }
-      for (const PendingReply& p : replies_) t = std::min(t, p.send_ns);
-      for (const PendingState& p : states_out_) t = std::min(t, p.send_ns);
-      if (t > end_ns) break;
-      now_ns_ = t;
-      for (size_t i = 0; i < syncs_.size(); ++i) {
-        requests.clear();
-        syncs_[i]->DueRequests(clocks_[i].Local(t), &requests);
-        for (const TimeSyncMessage& r : requests) Send(static_cast<int>(i), r);
-        if (states_ && clocks_[i].TrueAt(next_state_ns_[i]) <= t) MakeState(static_cast<int>(i));
-      }
-      for (size_t k = 0; k < states_out_.size();) {
-        if (states_out_[k].send_ns <= t) {
-          const PendingState& p = states_out_[k];
-          ASSERT_TRUE(channels_[p.from].Send(now_ns_, kBroadcastId, p.state, p.local_send_ns).ok());
-          states_out_.erase(states_out_.begin() + static_cast<std::ptrdiff_t>(k));
-        } else {
-          ++k;
-        }
-      }
-      for (size_t k = 0; k < replies_.size();) {
-        if (replies_[k].send_ns <= t) {
-          Send(replies_[k].from, replies_[k].reply);
-          replies_.erase(replies_.begin() + static_cast<std::ptrdiff_t>(k));
-        } else {
-          ++k;
-        }
-      }
-      for (size_t i = 0; i < syncs_.size(); ++i) {
-        inbox.clear();
-        ASSERT_TRUE(channels_[i].Poll(t, &inbox).ok());
-        for (const ReceivedMessage& m : inbox) {
-          const int64_t arrival = clocks_[i].Local(m.arrival_ns);
-          if (const auto* state = std::get_if<EgoStateMessage>(&m.message)) {
-            syncs_[i]->NoteTeammateState(*state, arrival);
-            continue;
-          }
-          const auto* sync_message = std::get_if<TimeSyncMessage>(&m.message);
-          ASSERT_NE(sync_message, nullptr);
-          TimeSyncMessage reply;
-          if (syncs_[i]->HandleMessage(*sync_message, arrival, arrival + turnaround_ns_, &reply)) {
-            replies_.push_back({clocks_[i].TrueAt(reply.t3_ns), static_cast<int>(i), reply});
-          }
-        }
-      }
-    }
-    now_ns_ = end_ns;
+    const Status s = sim_->RunUntil(end_ns);
+    ASSERT_TRUE(s.ok()) << s.message();
   }
-
-  /// True offset of j's clock relative to i's at the current time [ns].
-  int64_t TrueOffset(int i, int j) const {
-    return clocks_[j].Local(now_ns_) - clocks_[i].Local(now_ns_);
-  }
-  ClockOffsetEstimate Estimate(int i, int j) const {
-    return syncs_[i]->Estimate(j, clocks_[i].Local(now_ns_));
-  }
-  /// Estimate minus truth [ns].
-  double Error(int i, int j) const {
-    return static_cast<double>(Estimate(i, j).offset_ns - TrueOffset(i, j));
-  }
-  const ClockSync& sync(int i) const { return *syncs_[i]; }
-  ClockSync& mutable_sync(int i) { return *syncs_[i]; }
-  const DroneClock& clock(int i) const { return clocks_[i]; }
-  int64_t now_ns() const { return now_ns_; }
-  int size() const { return static_cast<int>(clocks_.size()); }
+  ClockOffsetEstimate Estimate(int i, int j) const { return sim_->Estimate(i, j); }
+  double Error(int i, int j) const { return sim_->Error(i, j); }
+  const ClockSync& sync(int i) const { return sim_->sync(i); }
+  ClockSync& mutable_sync(int i) { return sim_->mutable_sync(i); }
+  const SimulatedClock& clock(int i) const { return sim_->clock(i); }
+  int64_t now_ns() const { return sim_->now_ns(); }
 
  private:
-  struct PendingReply {
-    int64_t send_ns;  // true time
-    int from;
-    TimeSyncMessage reply;
-  };
-  struct PendingState {
-    int64_t send_ns;        // true time
-    int64_t local_send_ns;  // the sender's clock
-    int from;
-    EgoStateMessage state;
-  };
-  /// Drone i's state at its next period: echoes in, sent a turnaround later.
-  void MakeState(int i) {
-    PendingState p;
-    p.from = i;
-    p.state = net_test::MakeEgoState(i, 0, 1);
-    p.state.stamp_ns = next_state_ns_[i];
-    p.state.session_start_ns = clocks_[i].Local(0);
-    syncs_[i]->EchoesFor(p.state.stamp_ns, &p.state.echoes);
-    ClockOffsetReport report;
-    if (syncs_[i]->ReportFor(p.state.stamp_ns, &report)) p.state.offset_report = report;
-    syncs_[i]->NoteOwnState(p.state.stamp_ns);
-    p.local_send_ns = p.state.stamp_ns + turnaround_ns_;
-    p.send_ns = clocks_[i].TrueAt(p.local_send_ns);
-    states_out_.push_back(std::move(p));
-    next_state_ns_[i] += kStatePeriodNs;
-  }
-  void Send(int from, const TimeSyncMessage& m) {
-    ASSERT_TRUE(channels_[from].Send(now_ns_, m.target_id, m).ok());
-  }
-
-  std::vector<DroneClock> clocks_;
-  int64_t turnaround_ns_;
-  PacketCodec codec_;
-  std::unique_ptr<SimulatedNetwork> network_;
-  std::vector<MessageChannel> channels_;
-  std::vector<std::unique_ptr<ClockSync>> syncs_;
-  std::vector<PendingReply> replies_;
-  bool states_;                         // exchange = state_echo
-  std::vector<int64_t> next_state_ns_;  // per drone, its clock
-  std::vector<PendingState> states_out_;
-  int64_t now_ns_ = 0;
+  std::unique_ptr<ClockSyncSimulation> sim_;
 };
 
 /// The TimeSync request/response scheme (the figures of docs/network.md §9).
@@ -199,56 +59,15 @@ ClockSyncOptions Requests() {
   return options;
 }
 
-/// Offsets of +-0.5 s and drifts of +-20 ppm (relative drift up to 40 ppm).
-std::vector<DroneClock> SwarmClocks() {
-  return {{1000 * kS + 500 * kMs, 20e-6}, {1000 * kS - 500 * kMs, -20e-6}, {1000 * kS, 0.0}};
-}
-
-/// Error figures of every pair, checked once per second of true time.
-struct CaseFigures {
-  double max_abs_ms = 0;         // after settle_s
-  double rms_ms = 0;             // after settle_s
-  double max_normalised = 0;     // max |error| / std after settle_s
-  double within_3_sigma = 0;     // fraction of checks with |error| <= 3 std
-  double within_2ms_from_s = 0;  // every check from this time on is within 2 ms
-  int checks = 0;
-};
-
 CaseFigures RunCase(const LinkOptions& link,
                     const ClockSyncOptions& options,
                     int seeds,
                     int end_s,
                     int settle_s,
-                    std::vector<DroneClock> clocks = SwarmClocks()) {
+                    const std::vector<SimulatedClock>& clocks = SwarmClocks()) {
   CaseFigures f;
-  double sum_sq = 0;
-  int covered = 0;
-  for (int seed = 1; seed <= seeds; ++seed) {
-    NetworkOptions network;
-    network.seed = seed;
-    network.default_link = link;
-    SyncSimulation sim(network, clocks, options);
-    for (int t = 1; t <= end_s; ++t) {
-      sim.RunUntil(t * kS);
-      for (int i = 0; i < sim.size(); ++i) {
-        for (int j = 0; j < sim.size(); ++j) {
-          if (i == j) continue;
-          const ClockOffsetEstimate e = sim.Estimate(i, j);
-          const double error = e.valid ? sim.Error(i, j) : 1e18;
-          if (std::abs(error) > 2 * kMs)
-            f.within_2ms_from_s = std::max<double>(f.within_2ms_from_s, t + 1);
-          if (t < settle_s) continue;
-          f.max_abs_ms = std::max(f.max_abs_ms, std::abs(error) / kMs);
-          f.max_normalised = std::max(f.max_normalised, std::abs(error) / e.std_ns);
-          covered += std::abs(error) <= 3.0 * e.std_ns ? 1 : 0;
-          sum_sq += error * error;
-          ++f.checks;
-        }
-      }
-    }
-  }
-  f.rms_ms = std::sqrt(sum_sq / std::max(f.checks, 1)) / kMs;
-  f.within_3_sigma = static_cast<double>(covered) / std::max(f.checks, 1);
+  const Status s = RunClockSyncCase(link, options, seeds, end_s, settle_s, clocks, &f);
+  EXPECT_TRUE(s.ok()) << s.message();
   return f;
 }
 
@@ -373,28 +192,6 @@ TEST(ClockSyncSimulation, DuplicatesAndHeavyReorderingDoNotMatter) {
       ASSERT_TRUE(sim.sync(i).ToLocal(j, sim.clock(j).Local(sim.now_ns()), &local));
       EXPECT_LT(std::abs(local - sim.clock(i).Local(sim.now_ns())), 2 * kMs);
     }
-  }
-}
-
-// Figures for docs/network.md that take a while (about 20 s):
-//   swarmlio_net_tests --gtest_also_run_disabled_tests --gtest_filter='*LongRunFigures*'
-TEST(ClockSyncSimulation, DISABLED_LongRunFigures) {
-  LinkOptions jitter;
-  jitter.latency_mean_s = 0.2;
-  jitter.jitter_std_s = 0.02;
-  jitter.loss_probability = 0.3;
-  for (int end_s : {60, 300, 900, 1800}) {
-    const CaseFigures f = RunCase(jitter, Requests(), 5, end_s, end_s);
-    std::printf(
-        "[ figures  ] 200 ms +- 20 ms, 30 %% loss, 1 Hz, at %4d s: max %.3f ms rms %.3f ms\n",
-        end_s, f.max_abs_ms, f.rms_ms);
-  }
-  for (int end_s : {10, 30, 60}) {
-    const CaseFigures f = RunCase(LossyDelayedLink(), Requests(), 10, end_s, end_s);
-    std::printf(
-        "[ figures  ] 200 ms +- 1 ms, 30 %% loss, held back, 1 Hz, at %4d s: max %.3f ms "
-        "rms %.3f ms\n",
-        end_s, f.max_abs_ms, f.rms_ms);
   }
 }
 
