@@ -56,10 +56,10 @@ std::string FrameCheck::Summary() const {
 }
 
 Status CheckGroundTruthFrame(const std::vector<ScanRecord>& scans,
-                             const std::vector<PoseStamped>& gt, GroundTruthFrame declared,
+                             const std::vector<PoseStamped>& gt, driver::GroundTruthFrame declared,
                              const FrameCheckOptions& options, FrameCheck* check) {
   FrameCheck c;
-  c.declared = declared != GroundTruthFrame::kAuto;
+  c.declared = declared != driver::GroundTruthFrame::kAuto;
   const int64_t max_gap_ns = static_cast<int64_t>(std::llround(options.max_gt_gap_s * 1e9));
   for (const ScanRecord& r : scans) {
     if (!r.updated) continue;
@@ -73,9 +73,9 @@ Status CheckGroundTruthFrame(const std::vector<ScanRecord>& scans,
         180.0 / M_PI;
     break;
   }
-  if (declared == GroundTruthFrame::kG) {
+  if (declared == driver::GroundTruthFrame::kG) {
     c.same_frame = true;
-  } else if (declared == GroundTruthFrame::kAuto) {
+  } else if (declared == driver::GroundTruthFrame::kAuto) {
     if (!c.compared) {
       return Status::FailedPrecondition("no estimated pose overlaps the ground truth");
     }

@@ -6,7 +6,7 @@
 
 namespace swarmlio::replay {
 
-Status DroneRunner::Create(const DroneInput& input, int drone_id,
+Status DroneRunner::Create(const driver::DroneInput& input, int drone_id,
                            std::unique_ptr<DroneRunner>* runner) {
   std::unique_ptr<DroneRunner> r(new DroneRunner());
   r->input_ = input;

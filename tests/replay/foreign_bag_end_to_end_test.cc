@@ -154,8 +154,8 @@ class ForeignBagTest : public ::testing::Test {
 
   // A manifest entry as a newcomer would write it: the bag and the sensor
   // description; topics found by type ("" = auto), ground truth "auto".
-  static DroneInput Input(const SimDrone& d, const std::string& bag) {
-    DroneInput in;
+  static driver::DroneInput Input(const SimDrone& d, const std::string& bag) {
+    driver::DroneInput in;
     in.name = "uav1";
     in.bag_path = bag;
     in.lidar = d.lidar;
@@ -165,14 +165,14 @@ class ForeignBagTest : public ::testing::Test {
     in.bag.ground_truth_topic = io::kAutoTopic;
     in.bag.point_time_unit = d.lidar.timestamp_unit;
     in.bag.spinning_lidar = d.lidar.type == LidarType::kSpinning;
-    in.odometry = DefaultOdometryOptions(d.lidar, d.imu);
+    in.odometry = driver::DefaultOdometryOptions(d.lidar, d.imu);
     in.odometry.imu_time_offset_s = d.imu_time_offset_s;
     return in;
   }
 
-  static RunResult Run(const DroneInput& input, const std::vector<PoseStamped>& truth) {
+  static RunResult Run(const driver::DroneInput& input, const std::vector<PoseStamped>& truth) {
     RunResult result;
-    SwarmManifest manifest;
+    driver::SwarmManifest manifest;
     manifest.name = "foreign";
     manifest.drones = {input};
     std::unique_ptr<SwarmReplay> run;
@@ -224,7 +224,7 @@ TEST_F(ForeignBagTest, SignFlippedImuAndForeignTopicsTrackLikeTheOriginal) {
   Edits flip;
   flip.flip_acceleration = true;
   ASSERT_TRUE(Rewrite(mid360_.bag, flipped_bag, same, flip).ok());
-  DroneInput flipped_input = Input(mid360_, flipped_bag);
+  driver::DroneInput flipped_input = Input(mid360_, flipped_bag);
   flipped_input.odometry.imu_init.acceleration_sign = 0;  // auto
   const RunResult flipped = Run(flipped_input, *truth_mid360_);
   EXPECT_EQ(flipped.init.reported_direction, SpecificForceDirection::kDown);
@@ -272,7 +272,7 @@ TEST_F(ForeignBagTest, SpinningCloudWithoutPointTimeTracksLikeTheOriginal) {
   EXPECT_EQ(reconstructed.stats.scans_point_time_from_azimuth,
             reconstructed.stats.scans_without_point_time);
 
-  DroneInput instant_input = Input(spinning_, no_time_bag);
+  driver::DroneInput instant_input = Input(spinning_, no_time_bag);
   instant_input.bag.reconstruct_point_time = io::PointTimeReconstruction::kNone;
   const RunResult instant = Run(instant_input, *truth_spinning_);
   EXPECT_EQ(instant.stats.scans_point_time_from_azimuth, 0);

@@ -11,7 +11,7 @@
 
 #include "swarmlio/math/so3.h"
 #include "swarmlio/replay/consistency.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 namespace swarmlio::replay {
 namespace {
@@ -53,7 +53,7 @@ TEST(FrameCheck, GroundTruthInGIsDetected) {
   MakeRun(&scans, &truth);
   FrameCheck check;
   ASSERT_TRUE(
-      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
+      CheckGroundTruthFrame(scans, truth, driver::GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
           .ok());
   EXPECT_TRUE(check.compared);
   EXPECT_TRUE(check.same_frame);
@@ -69,7 +69,7 @@ TEST(FrameCheck, ForeignFrameIsDetectedAndAlignedByTheFirstPose) {
   const std::vector<PoseStamped> world = InWorld(truth);
   FrameCheck check;
   ASSERT_TRUE(
-      CheckGroundTruthFrame(scans, world, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
+      CheckGroundTruthFrame(scans, world, driver::GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
           .ok());
   EXPECT_FALSE(check.same_frame);
   EXPECT_GT(check.position_offset_m, 1.0);
@@ -89,11 +89,11 @@ TEST(FrameCheck, ForeignFrameIsDetectedAndAlignedByTheFirstPose) {
 
   // Declared: the manifest wins over the detection.
   ASSERT_TRUE(
-      CheckGroundTruthFrame(scans, world, GroundTruthFrame::kG, FrameCheckOptions(), &check).ok());
+      CheckGroundTruthFrame(scans, world, driver::GroundTruthFrame::kG, FrameCheckOptions(), &check).ok());
   EXPECT_TRUE(check.same_frame);
   EXPECT_TRUE(check.declared);
   ASSERT_TRUE(
-      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kOther, FrameCheckOptions(), &check)
+      CheckGroundTruthFrame(scans, truth, driver::GroundTruthFrame::kOther, FrameCheckOptions(), &check)
           .ok());
   EXPECT_FALSE(check.same_frame);
 }
@@ -179,32 +179,32 @@ TEST(FrameCheck, NoOverlapIsAnError) {
   for (PoseStamped& p : truth) p.stamp_ns += 100'000'000'000LL;
   FrameCheck check;
   EXPECT_EQ(
-      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
+      CheckGroundTruthFrame(scans, truth, driver::GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
           .code(),
       Status::Code::kFailedPrecondition);
 }
 
 TEST(FrameCheck, ManifestKeyGroundTruthFrame) {
-  SwarmManifest manifest;
-  const Status status = ParseManifest(
+  driver::SwarmManifest manifest;
+  const Status status = driver::ParseManifest(
       "name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: G}\n"
       "  - {name: b, bag: b.bag, ground_truth_frame: other}\n  - {name: c, bag: c.bag}\n",
       "/tmp/m.yaml", &manifest);
   ASSERT_TRUE(status.ok()) << status.message();
-  EXPECT_EQ(manifest.drones[0].ground_truth_frame, GroundTruthFrame::kG);
-  EXPECT_EQ(manifest.drones[1].ground_truth_frame, GroundTruthFrame::kOther);
-  EXPECT_EQ(manifest.drones[2].ground_truth_frame, GroundTruthFrame::kAuto);
-  EXPECT_FALSE(ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: W}\n",
+  EXPECT_EQ(manifest.drones[0].ground_truth_frame, driver::GroundTruthFrame::kG);
+  EXPECT_EQ(manifest.drones[1].ground_truth_frame, driver::GroundTruthFrame::kOther);
+  EXPECT_EQ(manifest.drones[2].ground_truth_frame, driver::GroundTruthFrame::kAuto);
+  EXPECT_FALSE(driver::ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: W}\n",
                              "/tmp/m.yaml", &manifest)
                    .ok());
 }
 
 TEST(FrameCheck, ManifestMarksSpinningLidars) {
-  SwarmManifest manifest;
+  driver::SwarmManifest manifest;
   const std::string preset = std::string(SWARMLIO_SOURCE_DIR) + "/configs/spinning_32.yaml";
-  ASSERT_TRUE(ManifestFromBags({"a.bag"}, preset, {}, &manifest).ok());
+  ASSERT_TRUE(driver::ManifestFromBags({"a.bag"}, preset, {}, &manifest).ok());
   EXPECT_TRUE(manifest.drones[0].bag.spinning_lidar);
-  ASSERT_TRUE(ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, sensor_preset: " + preset +
+  ASSERT_TRUE(driver::ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, sensor_preset: " + preset +
                                 ", bag_topics: {spinning_lidar: false}}\n",
                             "/tmp/m.yaml", &manifest)
                   .ok());

@@ -1,10 +1,10 @@
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-namespace swarmlio::replay {
+namespace swarmlio::driver {
 namespace {
 
 const std::string kPresets = std::string(SWARMLIO_SOURCE_DIR) + "/configs/";
@@ -95,4 +95,4 @@ TEST(Manifest, FromBags) {
 }
 
 }  // namespace
-}  // namespace swarmlio::replay
+}  // namespace swarmlio::driver

@@ -14,7 +14,7 @@
 #include "swarmlio/lio/odometry.h"
 #include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/drone_runner.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
 
@@ -88,7 +88,7 @@ void LoadScenarioWithSeed(const std::string& name, int seed, sim::Scenario* scen
 // the simulator hands over (with its error, not the truth).
 void RunWithGivenCalibration(sim::Simulator* simulator, const sim::DroneConfig& d, int index,
                              replay::ConsistencyStats* consistency) {
-  lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+  lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
   const sim::SensorCalibration given = sim::GivenCalibration(d);
   options.imu_time_offset_s = given.imu_time_offset_s;
   LidarOptions lidar = d.lidar.sensor;
@@ -123,7 +123,7 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
   for (const Case c : {Case{0, 0.02, 1.8}, Case{2, 0.06, 0.75}}) {
     const sim::DroneConfig& d = drones[c.drone];
     SCOPED_TRACE(d.name);
-    lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
     options.imu_time_offset_s = d.imu.time_offset_s;
     std::unique_ptr<lio::Odometry> odometry;
     ASSERT_TRUE(lio::Odometry::Create(options, d.lidar.sensor, &odometry).ok());
@@ -176,7 +176,7 @@ TEST(OdometryEndToEnd, StaticStartScansSeedTheMap) {
   const sim::DroneConfig& d = drones[2];  // uav3, Avia
   for (const bool seed : {true, false}) {
     SCOPED_TRACE(seed ? "seeded" : "not seeded");
-    lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
     options.imu_time_offset_s = d.imu.time_offset_s;
     options.seed_map_from_static_start = seed;
     std::unique_ptr<lio::Odometry> odometry;

@@ -29,7 +29,7 @@ class SwarmEndToEndTest : public ::testing::Test {
     dir_ = new fs::path(fs::temp_directory_path() /
                         ("swarmlio_swarm_e2e_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
-    manifest_ = new SwarmManifest();
+    manifest_ = new driver::SwarmManifest();
     ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
         std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/wall_degenerate.yaml",
         "wall_degenerate", 36.0, *dir_, manifest_));
@@ -66,11 +66,11 @@ class SwarmEndToEndTest : public ::testing::Test {
   }
 
   static fs::path* dir_;
-  static SwarmManifest* manifest_;
+  static driver::SwarmManifest* manifest_;
 };
 
 fs::path* SwarmEndToEndTest::dir_ = nullptr;
-SwarmManifest* SwarmEndToEndTest::manifest_ = nullptr;
+driver::SwarmManifest* SwarmEndToEndTest::manifest_ = nullptr;
 
 TEST_F(SwarmEndToEndTest, TeammatesKeepTheWallFacingAviaFromDrifting) {
   std::vector<int> identified_swarm, identified_single;
@@ -126,8 +126,8 @@ TEST_F(SwarmEndToEndTest, LateObservationsStillHoldTheWallFacingAvia) {
 TEST_F(SwarmEndToEndTest, RepeatedObservationsReplaceLostOnesAndNeverCountTwice) {
   using swarm::RepeatObservations;
   const auto run = [](double loss, RepeatObservations repeat) {
-    SwarmManifest manifest = *manifest_;
-    for (DroneInput& d : manifest.drones) {
+    driver::SwarmManifest manifest = *manifest_;
+    for (driver::DroneInput& d : manifest.drones) {
       d.swarm.repeat_observations = repeat;
       // The repeats' own mechanism, without the byte budget's choices (which
       // drop repeats when the observers are at their budget: docs/swarm.md
@@ -180,7 +180,7 @@ TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
   const fs::path dir =
       fs::temp_directory_path() / ("swarmlio_swarm_clock_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  SwarmManifest manifest;
+  driver::SwarmManifest manifest;
   const std::vector<double> offsets_s = {0.0, 0.5, -0.5};
   const std::vector<double> drifts_ppm = {0.0, 30.0, -20.0};
   ASSERT_TRUE(swarmlio::testing::SimulateSwarm(

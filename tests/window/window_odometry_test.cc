@@ -31,7 +31,7 @@
 #include "swarmlio/math/so3.h"
 #include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/drone_runner.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
 
@@ -105,7 +105,7 @@ Simulation Indoor(double duration_s) {
 }
 
 lio::OdometryOptions Options(const sim::DroneConfig& d, lio::EstimatorKind estimator, int size) {
-  lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+  lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
   options.imu_time_offset_s = d.imu.time_offset_s;
   options.estimator = estimator;
   options.window.size = size;
@@ -242,8 +242,8 @@ TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
       "  - name: b\n"
       "    bag: b.bag\n"
       "    sensor_preset: " + presets + "livox_avia.yaml\n";
-  replay::SwarmManifest m;
-  const Status status = replay::ParseManifest(yaml, "/data/swarm.yaml", &m);
+  driver::SwarmManifest m;
+  const Status status = driver::ParseManifest(yaml, "/data/swarm.yaml", &m);
   ASSERT_TRUE(status.ok()) << status.message();
   ASSERT_EQ(m.drones.size(), 2u);
   EXPECT_EQ(m.drones[0].odometry.estimator, lio::EstimatorKind::kWindow);
@@ -258,7 +258,7 @@ TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
       "  - name: a\n"
       "    bag: a.bag\n"
       "    odometry: {estimator: smoother}\n";
-  const Status refused = replay::ParseManifest(bad, "/data/swarm.yaml", &m);
+  const Status refused = driver::ParseManifest(bad, "/data/swarm.yaml", &m);
   EXPECT_FALSE(refused.ok());
   EXPECT_NE(refused.message().find("estimator"), std::string::npos) << refused.message();
 }

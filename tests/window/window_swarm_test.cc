@@ -38,7 +38,7 @@ class WindowSwarmTest : public ::testing::Test {
     dir_ = new fs::path(fs::temp_directory_path() /
                         ("swarmlio_window_swarm_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
-    manifest_ = new SwarmManifest();
+    manifest_ = new driver::SwarmManifest();
     ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
         std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "indoor_3uav", 22.0, *dir_,
         manifest_));
@@ -51,8 +51,8 @@ class WindowSwarmTest : public ::testing::Test {
   }
 
   static std::vector<DroneRun> Run(lio::EstimatorKind estimator, int window_size) {
-    SwarmManifest manifest = *manifest_;
-    for (DroneInput& d : manifest.drones) {
+    driver::SwarmManifest manifest = *manifest_;
+    for (driver::DroneInput& d : manifest.drones) {
       d.odometry.estimator = estimator;
       d.odometry.window.size = window_size;
     }
@@ -75,11 +75,11 @@ class WindowSwarmTest : public ::testing::Test {
   }
 
   static fs::path* dir_;
-  static SwarmManifest* manifest_;
+  static driver::SwarmManifest* manifest_;
 };
 
 fs::path* WindowSwarmTest::dir_ = nullptr;
-SwarmManifest* WindowSwarmTest::manifest_ = nullptr;
+driver::SwarmManifest* WindowSwarmTest::manifest_ = nullptr;
 
 // Largest difference of the teammate extrinsics between two runs over the
 // scans where both estimate the same teammate [m], [deg].

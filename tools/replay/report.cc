@@ -88,7 +88,7 @@ Status WriteNetwork(const std::string& path, const replay::SwarmReplay& run) {
 }
 
 // Moves plotted positions from a drone's G into the common frame W.
-Eigen::Matrix3Xd ToWorld(const replay::DroneInput& d, const Eigen::Matrix3Xd& p_in_G) {
+Eigen::Matrix3Xd ToWorld(const driver::DroneInput& d, const Eigen::Matrix3Xd& p_in_G) {
   Eigen::Matrix3Xd out = d.R_W_G * p_in_G;
   out.colwise() += d.p_G_in_W_m;
   return out;

@@ -32,7 +32,7 @@
 #include "swarmlio/net/swarm_key_file.h"
 #include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/dropped_scans.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
 
 DEFINE_string(manifest, "", "swarm manifest YAML (docs/replay.md); or use --bags");
@@ -126,8 +126,8 @@ Status ApplyReceivedPacketFlags(replay::ReplayOptions* options) {
 }
 
 // The back-end flags, applied to every drone's odometry options.
-Status ApplyEstimatorFlags(replay::SwarmManifest* manifest) {
-  for (replay::DroneInput& d : manifest->drones) {
+Status ApplyEstimatorFlags(driver::SwarmManifest* manifest) {
+  for (driver::DroneInput& d : manifest->drones) {
     lio::OdometryOptions& o = d.odometry;
     if (!FLAGS_estimator.empty() && !config::EnumFromString(FLAGS_estimator, &o.estimator)) {
       return Status::InvalidArgument("--estimator=" + FLAGS_estimator + ": expected one of " +
@@ -291,11 +291,11 @@ int Main() {
                  "[--sensor_preset=FILE] [--names=a,b]) --output_dir=DIR\n");
     return 2;
   }
-  replay::SwarmManifest manifest;
+  driver::SwarmManifest manifest;
   Status status = FLAGS_manifest.empty()
-                      ? replay::ManifestFromBags(Split(FLAGS_bags), FLAGS_sensor_preset,
+                      ? driver::ManifestFromBags(Split(FLAGS_bags), FLAGS_sensor_preset,
                                                  Split(FLAGS_names), &manifest)
-                      : replay::LoadManifest(FLAGS_manifest, &manifest);
+                      : driver::LoadManifest(FLAGS_manifest, &manifest);
   if (!status.ok()) {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());
     return 1;

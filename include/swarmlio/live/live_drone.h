@@ -38,13 +38,13 @@
 #include "swarmlio/net/message_channel.h"
 #include "swarmlio/net/swarm_key.h"
 #include "swarmlio/net/transport.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/swarm/drone_estimator.h"
 
 namespace swarmlio::live {
 
 struct LiveSetup {
-  replay::DroneInput drone;  // bag (unless `source`), sensors, estimator options
+  driver::DroneInput drone;  // bag (unless `source`), sensors, estimator options
   int drone_id = 0;          // swarm id (index in the manifest; the same on every drone)
   net::SwarmKey key;         // the swarm's pre-shared key
   net::Transport* transport = nullptr;  // not owned; used by the network thread only

@@ -28,7 +28,7 @@
 
 #include "swarmlio/common/status.h"
 #include "swarmlio/replay/drone_runner.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/sensors/measurements.h"
 
 namespace swarmlio::replay {
@@ -74,7 +74,7 @@ struct FrameCheck {
 /// the ground truth covers; `declared` (manifest ground_truth_frame) decides
 /// when not kAuto. FailedPrecondition when no scan overlaps the ground truth.
 Status CheckGroundTruthFrame(const std::vector<ScanRecord>& scans,
-                             const std::vector<PoseStamped>& gt, GroundTruthFrame declared,
+                             const std::vector<PoseStamped>& gt, driver::GroundTruthFrame declared,
                              const FrameCheckOptions& options, FrameCheck* check);
 
 /// The ground truth moved into G by its first pose: every pose is premultiplied

@@ -14,7 +14,7 @@
 #include "swarmlio/common/status.h"
 #include "swarmlio/io/bag_reader.h"
 #include "swarmlio/lio/odometry.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/swarm/drone_estimator.h"
 
@@ -71,7 +71,7 @@ class DroneRunner {
  public:
   /// Opens the bag and creates the estimator. Errors name the drone.
   /// `drone_id`: the drone's index in the manifest (its swarm id).
-  static Status Create(const DroneInput& input, int drone_id, std::unique_ptr<DroneRunner>* runner);
+  static Status Create(const driver::DroneInput& input, int drone_id, std::unique_ptr<DroneRunner>* runner);
 
   /// True while the bag has records left (after Prime()).
   bool has_next() const { return has_next_; }
@@ -100,7 +100,7 @@ class DroneRunner {
     return identifications_;
   }
 
-  const DroneInput& input() const { return input_; }
+  const driver::DroneInput& input() const { return input_; }
   const std::vector<ScanRecord>& scans() const { return scans_; }
   const std::vector<PoseStamped>& bag_ground_truth() const { return ground_truth_; }
   const lio::Odometry& odometry() const { return estimator_->odometry(); }
@@ -118,7 +118,7 @@ class DroneRunner {
   void Collect();
   void Warn(const Status& status);
 
-  DroneInput input_;
+  driver::DroneInput input_;
   std::unique_ptr<io::BagReader> reader_;
   std::unique_ptr<swarm::DroneEstimator> estimator_;
   io::BagRecord next_;

@@ -1,4 +1,4 @@
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/config/sensor_preset.h"
 
-namespace swarmlio::replay {
+namespace swarmlio::driver {
 namespace {
 
 using config::FieldSpec;
@@ -225,4 +225,4 @@ Status ManifestFromBags(const std::vector<std::string>& bags, const std::string&
   return Status::Ok();
 }
 
-}  // namespace swarmlio::replay
+}  // namespace swarmlio::driver

@@ -37,7 +37,7 @@
 #include "swarmlio/swarm/swarm_options.h"
 #include "swarmlio/teammate/teammate_detector_options.h"
 
-namespace swarmlio::replay {
+namespace swarmlio::driver {
 
 /// Frame of a drone's ground truth (manifest key `ground_truth_frame`).
 ///   kAuto:  G when the ground truth at the estimate's first stamp matches the
@@ -133,16 +133,16 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
 Status ManifestFromBags(const std::vector<std::string>& bags, const std::string& sensor_preset,
                         const std::vector<std::string>& names, SwarmManifest* manifest);
 
-}  // namespace swarmlio::replay
+}  // namespace swarmlio::driver
 
 namespace swarmlio::config {
 
 template <>
-struct EnumTraits<replay::GroundTruthFrame> {
-  static constexpr std::array<std::pair<replay::GroundTruthFrame, const char*>, 3> kNames{{
-      {replay::GroundTruthFrame::kAuto, "auto"},
-      {replay::GroundTruthFrame::kG, "G"},
-      {replay::GroundTruthFrame::kOther, "other"},
+struct EnumTraits<driver::GroundTruthFrame> {
+  static constexpr std::array<std::pair<driver::GroundTruthFrame, const char*>, 3> kNames{{
+      {driver::GroundTruthFrame::kAuto, "auto"},
+      {driver::GroundTruthFrame::kG, "G"},
+      {driver::GroundTruthFrame::kOther, "other"},
   }};
 };
 
