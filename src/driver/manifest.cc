@@ -19,7 +19,7 @@ struct DroneEntry {
   std::string name;
   std::string bag;
   std::string ground_truth;
-  GroundTruthFrame ground_truth_frame = GroundTruthFrame::kAuto;
+  eval::GroundTruthFrame ground_truth_frame = eval::GroundTruthFrame::kAuto;
   std::string sensor_preset;
   LidarOptions lidar;
   ImuOptions imu;

@@ -81,6 +81,20 @@ ScanRecord ToScanRecord(const swarm::DroneOutput& o) {
   return r;
 }
 
+eval::CovariantTrajectory UpdatedEstimate(const std::vector<ScanRecord>& scans) {
+  eval::CovariantTrajectory out;
+  for (const ScanRecord& s : scans) {
+    if (!s.updated) continue;
+    Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+    T_G_b.linear() = s.state.q_G_b.normalized().toRotationMatrix();
+    T_G_b.translation() = s.state.p_b_in_G;
+    out.poses.stamps_s.push_back(StampSeconds(s.stamp_ns));
+    out.poses.T_G_b.push_back(T_G_b);
+    out.position_covariances.push_back(s.pose_covariance.bottomRightCorner<3, 3>());
+  }
+  return out;
+}
+
 void DroneRunner::Deliver(const net::ReceivedMessage& message) {
   Warn(estimator_->AddMessage(message));
 }

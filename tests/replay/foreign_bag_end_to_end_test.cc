@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "swarmlio/config/sensor_preset.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/io/bag_reader.h"
 #include "swarmlio/io/bag_writer.h"
 #include "swarmlio/math/so3.h"
-#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/swarm_replay.h"
 #include "swarmlio/sim/output_writer.h"
 #include "swarmlio/sim/scenario.h"
@@ -109,7 +109,7 @@ Status Rewrite(const std::string& in, const std::string& out, const io::BagWrite
 
 struct RunResult {
   double rmse_m = 0.0;  // vs the original ground truth (in G)
-  FrameCheck frame;
+  eval::FrameCheck frame;
   ImuInitialization init;
   io::ReadStats stats;
   std::string imu_topic, lidar_topic, ground_truth_topic;
@@ -188,12 +188,16 @@ class ForeignBagTest : public ::testing::Test {
     result.imu_topic = d.reader().imu_topic();
     result.lidar_topic = d.reader().lidar_topic();
     result.ground_truth_topic = d.reader().ground_truth_topic();
-    ConsistencyStats cs;
-    EXPECT_TRUE(EvaluateConsistency(d.scans(), truth, 0.05, &cs).ok());
+    eval::ConsistencyStats cs;
+    EXPECT_TRUE(eval::EvaluateConsistency(UpdatedEstimate(d.scans()),
+                                          eval::TrajectoryFromPoses(truth), 0.05, &cs)
+                    .ok());
     result.rmse_m = cs.position_rmse_m;
     if (!d.bag_ground_truth().empty()) {
-      EXPECT_TRUE(CheckGroundTruthFrame(d.scans(), d.bag_ground_truth(), input.ground_truth_frame,
-                                        FrameCheckOptions(), &result.frame)
+      EXPECT_TRUE(eval::CheckGroundTruthFrame(UpdatedEstimate(d.scans()).poses,
+                                              eval::TrajectoryFromPoses(d.bag_ground_truth()),
+                                              input.ground_truth_frame, eval::FrameCheckOptions(),
+                                              &result.frame)
                       .ok());
     }
     return result;

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/replay/consistency.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/replay/swarm_replay.h"
 #include "test_utils/simulated_swarm.h"
 
@@ -55,10 +55,11 @@ class SwarmEndToEndTest : public ::testing::Test {
     EXPECT_TRUE(run->Run(options).ok());
     std::vector<double> rmse;
     for (int i = 0; i < run->num_drones(); ++i) {
-      ConsistencyStats c;
-      EXPECT_TRUE(
-          EvaluateConsistency(run->drone(i).scans(), run->drone(i).bag_ground_truth(), 0.05, &c)
-              .ok());
+      eval::ConsistencyStats c;
+      EXPECT_TRUE(eval::EvaluateConsistency(
+                      UpdatedEstimate(run->drone(i).scans()),
+                      eval::TrajectoryFromPoses(run->drone(i).bag_ground_truth()), 0.05, &c)
+                      .ok());
       rmse.push_back(c.position_rmse_m);
       identified->push_back(static_cast<int>(run->drone(i).identifications().size()));
     }
@@ -215,9 +216,10 @@ TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
       EXPECT_LT(std::abs(estimate.offset_ns - truth_ns), 2'000'000) << i << " -> " << j;
     }
   }
-  ConsistencyStats avia;
-  ASSERT_TRUE(EvaluateConsistency(run->drone(0).scans(), run->drone(0).bag_ground_truth(), 0.05,
-                                  &avia)
+  eval::ConsistencyStats avia;
+  ASSERT_TRUE(eval::EvaluateConsistency(UpdatedEstimate(run->drone(0).scans()),
+                                        eval::TrajectoryFromPoses(run->drone(0).bag_ground_truth()),
+                                        0.05, &avia)
                   .ok());
   std::printf("[ figures  ] wall-facing Avia with clocks 0.5 s apart: position RMSE %.4f m\n",
               avia.position_rmse_m);

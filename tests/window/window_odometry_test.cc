@@ -27,11 +27,11 @@
 #include <utility>
 #include <vector>
 
+#include "swarmlio/driver/manifest.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/lio/odometry.h"
 #include "swarmlio/math/so3.h"
-#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/drone_runner.h"
-#include "swarmlio/driver/manifest.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
 
@@ -196,8 +196,11 @@ TEST(WindowOdometry, WindowOfFiveTracksAShortIndoorFlight) {
     int updated = 0;
     for (const auto& s : scans) updated += s.updated ? 1 : 0;
     EXPECT_GE(updated, static_cast<int>(scans.size()) - 1);
-    replay::ConsistencyStats consistency;
-    ASSERT_TRUE(replay::EvaluateConsistency(scans, sink.ground_truth, 0.05, &consistency).ok());
+    eval::ConsistencyStats consistency;
+    ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(scans),
+                                          eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
+                                          &consistency)
+                    .ok());
     std::printf("[ figures  ] %s, %s: position RMSE %.4f m, rotation RMSE %.3f deg, mean "
                 "position NEES %.2f\n",
                 d.name.c_str(), name, consistency.position_rmse_m, consistency.rotation_rmse_deg,

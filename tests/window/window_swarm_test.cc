@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/math/so3.h"
-#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/swarm_replay.h"
 #include "test_utils/simulated_swarm.h"
 
@@ -64,8 +64,11 @@ class WindowSwarmTest : public ::testing::Test {
       const DroneRunner& d = run->drone(i);
       DroneRun r;
       r.scans = d.scans();
-      ConsistencyStats c;
-      EXPECT_TRUE(EvaluateConsistency(d.scans(), d.bag_ground_truth(), 0.05, &c).ok());
+      eval::ConsistencyStats c;
+      EXPECT_TRUE(eval::EvaluateConsistency(UpdatedEstimate(d.scans()),
+                                            eval::TrajectoryFromPoses(d.bag_ground_truth()), 0.05,
+                                            &c)
+                      .ok());
       r.position_rmse_m = c.position_rmse_m;
       r.identified = static_cast<int>(d.identifications().size());
       for (const ScanRecord& s : d.scans()) r.fused += s.active_observations + s.passive_observations;

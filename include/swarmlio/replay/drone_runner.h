@@ -12,9 +12,10 @@
 #include <vector>
 
 #include "swarmlio/common/status.h"
+#include "swarmlio/driver/manifest.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/io/bag_reader.h"
 #include "swarmlio/lio/odometry.h"
-#include "swarmlio/driver/manifest.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/swarm/drone_estimator.h"
 
@@ -61,6 +62,10 @@ struct ScanRecord {
 /// The record kept of one estimator output.
 ScanRecord ToScanRecord(const lio::ScanOutput& output);
 ScanRecord ToScanRecord(const swarm::DroneOutput& output);
+
+/// The updated scans' poses with their position covariances (the estimate
+/// eval::EvaluateConsistency and eval::CheckGroundTruthFrame take).
+eval::CovariantTrajectory UpdatedEstimate(const std::vector<ScanRecord>& scans);
 
 struct DroneWarnings {
   int64_t count = 0;
