@@ -228,18 +228,18 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
   }
   if (!d.bag_ground_truth().empty()) {
     // NEES only when the ground truth is known to be in G (docs/replay.md).
-    const eval::CovariantTrajectory updated = replay::UpdatedEstimate(d.scans());
+    const eval::CovariantTrajectory estimate = replay::UpdatedEstimate(d.scans());
     const eval::Trajectory truth = eval::TrajectoryFromPoses(d.bag_ground_truth());
     eval::FrameCheck frame;
     eval::ConsistencyStats cs;
     eval::Trajectory aligned;
-    Status status = eval::CheckGroundTruthFrame(updated.poses, truth, d.input().ground_truth_frame,
+    Status status = eval::CheckGroundTruthFrame(estimate.poses, truth, d.input().ground_truth_frame,
                                                 eval::FrameCheckOptions(), &frame);
     if (status.ok() && !frame.same_frame) {
-      status = eval::AlignGroundTruthByFirstPose(updated.poses, truth, frame, 0.05, &aligned);
+      status = eval::AlignGroundTruthByFirstPose(estimate.poses, truth, frame, 0.05, &aligned);
     }
     if (status.ok()) {
-      status = eval::EvaluateConsistency(updated, frame.same_frame ? truth : aligned, 0.05, &cs);
+      status = eval::EvaluateConsistency(estimate, frame.same_frame ? truth : aligned, 0.05, &cs);
     }
     if (status.ok()) {
       std::printf("  %s\n", frame.Summary().c_str());
