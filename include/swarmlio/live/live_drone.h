@@ -2,7 +2,8 @@
 // takes the drone's sensor records from a RecordSource (record_source.h):
 // its bag played at `rate` x real time against an injected Clock
 // (BagPlaybackSource, the default), or records pushed by a driver such as the
-// ROS node (PushSource); runs its swarm::DroneEstimator and talks to the
+// ROS node (PushSource); runs its swarm::DroneEstimator through the drivers'
+// one loop (driver::DroneDriver) and talks to the
 // teammates through a real net::Transport (UdpTransport), with three threads:
 //
 //   input      takes each record from the source when it is due (bag:
