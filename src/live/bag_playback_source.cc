@@ -13,7 +13,7 @@ constexpr int64_t kMaxSleepNs = 5'000'000;  // Interrupt() is noticed within thi
 
 }  // namespace
 
-Status BagPlaybackSource::Open(const replay::DroneInput& drone, double start_offset_s,
+Status BagPlaybackSource::Open(const driver::DroneInput& drone, double start_offset_s,
                                const Clock* clock, std::unique_ptr<BagPlaybackSource>* source) {
   const std::string& name = drone.name;
   if (clock == nullptr) return Status::InvalidArgument(name + ": bag playback needs a clock");

@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "swarmlio/driver/drone_driver.h"
 #include "swarmlio/io/bag_reader.h"
 #include "swarmlio/live/bag_playback_source.h"
 #include "swarmlio/live/bounded_queue.h"
@@ -40,13 +41,15 @@ LiveSink g_null_sink;
 
 }  // namespace
 
-struct LiveDrone::Impl {
+// The estimator thread is the DroneDriver's; the Impl is its sink.
+struct LiveDrone::Impl : driver::DriverSink {
   LiveSetup setup;
   LiveOptions options;
   LiveSink* sink = &g_null_sink;
   std::unique_ptr<RecordSource> owned_source;  // the bag playback when setup.source is null
   RecordSource* source = nullptr;
-  std::unique_ptr<swarm::DroneEstimator> estimator;
+  std::unique_ptr<driver::DroneDriver> loop;  // the component in the drivers' one loop
+  bool flushing = false;                      // the outputs come from the final flush
   std::unique_ptr<ImuRateOdometry> imu_rate;
   net::PacketCodec codec;
   std::unique_ptr<RecordingTransport> recording;
@@ -76,14 +79,12 @@ struct LiveDrone::Impl {
   void NetworkLoop();
   void WaitForNetwork(int64_t stamp_ns);
   void Deliver(int64_t stamp_ns, std::deque<net::ReceivedMessage>* pending);
-  void Collect(std::vector<swarm::DroneOutput>* outputs, bool at_flush = false);
-  void QueueOutgoing(std::vector<net::SwarmMessage>* messages);
+  void OnOutputs(const std::vector<swarm::DroneOutput>& outputs) override;
+  void OnMessages(std::vector<net::SwarmMessage>* messages) override;
   void Send(const Outgoing& out);
-  void Warn(const Status& status);
   double AccelerationFactor() const {
-    return estimator->odometry().initialized()
-               ? estimator->odometry().initialization().acceleration_to_m_s2
-               : 1.0;
+    const lio::Odometry& odometry = loop->estimator().odometry();
+    return odometry.initialized() ? odometry.initialization().acceleration_to_m_s2 : 1.0;
   }
 };
 
@@ -121,13 +122,7 @@ Status LiveDrone::Create(const LiveSetup& setup, const LiveOptions& options,
     im.owned_source = std::move(bag);
     im.source = im.owned_source.get();
   }
-  swarm::DroneEstimatorOptions estimator_options;
-  estimator_options.odometry = setup.drone.odometry;
-  estimator_options.teammate = setup.drone.teammate;
-  estimator_options.swarm = setup.drone.swarm;
-  status = swarm::DroneEstimator::Create(setup.drone_id, estimator_options, setup.drone.lidar,
-                                         &im.estimator);
-  if (!status.ok()) return status.WithContext(name);
+  SWARMLIO_RETURN_IF_ERROR(driver::DroneDriver::Create(setup.drone, setup.drone_id, &im, &im.loop));
   im.imu_rate = std::make_unique<ImuRateOdometry>(
       static_cast<int64_t>(std::llround(setup.drone.odometry.imu_time_offset_s * 1e9)));
   SWARMLIO_RETURN_IF_ERROR(net::PacketCodec::Create(setup.key, &im.codec));
@@ -153,7 +148,7 @@ Status LiveDrone::Create(const LiveSetup& setup, const LiveOptions& options,
 LiveDrone::~LiveDrone() = default;
 
 const LiveStats& LiveDrone::stats() const { return impl_->stats; }
-const swarm::DroneEstimator& LiveDrone::estimator() const { return *impl_->estimator; }
+const swarm::DroneEstimator& LiveDrone::estimator() const { return impl_->loop->estimator(); }
 const SensorTimeMapping& LiveDrone::mapping() const { return impl_->mapping; }
 
 void LiveDrone::Stop() {
@@ -188,6 +183,8 @@ Status LiveDrone::Run() {
   im.stats.clock_elapsed_ns = im.setup.clock->NowNs() - im.mapping.clock_start_ns;
   im.stats.channel = im.channel->stats();
   im.stats.datagrams_logged = im.recording->logged();
+  im.stats.estimator_warnings = im.loop->warnings().count;
+  im.stats.first_warning = im.loop->warnings().first;
   const Status log_status = im.recording->CloseLog();
   if (!im.input_error.ok()) return im.input_error;
   if (!im.network_error.ok()) return im.network_error.WithContext(im.setup.drone.name);
@@ -238,40 +235,27 @@ void LiveDrone::Impl::Deliver(int64_t stamp_ns, std::deque<net::ReceivedMessage>
     pending->push_back(std::move(*m));
   }
   while (!pending->empty() && pending->front().arrival_ns <= stamp_ns) {
-    Warn(estimator->AddMessage(pending->front()));
+    loop->Add(std::move(pending->front()));
     ++stats.messages_delivered;
     pending->pop_front();
   }
 }
 
-void LiveDrone::Impl::Warn(const Status& status) {
-  if (status.ok()) return;
-  if (stats.estimator_warnings == 0) stats.first_warning = status.message();
-  ++stats.estimator_warnings;
-}
-
-void LiveDrone::Impl::Collect(std::vector<swarm::DroneOutput>* outputs, bool at_flush) {
-  outputs->clear();
-  estimator->PopOutputs(outputs);
-  if (outputs->empty()) return;
+void LiveDrone::Impl::OnOutputs(const std::vector<swarm::DroneOutput>& outputs) {
   const int64_t now_ns = setup.clock->NowNs();
-  for (const swarm::DroneOutput& o : *outputs) {
+  for (const swarm::DroneOutput& o : outputs) {
     ++stats.scans_processed;
     if (o.ego.held_by_initialization) ++stats.scans_held_by_initialization;
-    if (!o.ego.update_error.empty()) Warn(Status::Internal("update failed: " + o.ego.update_error));
-    if (!o.ego.front_end_error.empty()) Warn(Status::Internal("swarm front end: " + o.ego.front_end_error));
     imu_rate->ResetToScan(o.ego.state, o.ego.stamp_ns, AccelerationFactor());
     ScanLatency latency;
     latency.scan_end_clock_ns = mapping.ToClockNs(o.ego.stamp_ns);
     latency.output_clock_ns = now_ns;
-    latency.at_flush = at_flush;
+    latency.at_flush = flushing;
     sink->OnScan(o, latency);
   }
 }
 
-void LiveDrone::Impl::QueueOutgoing(std::vector<net::SwarmMessage>* out) {
-  out->clear();
-  estimator->PopMessages(out);
+void LiveDrone::Impl::OnMessages(std::vector<net::SwarmMessage>* out) {
   for (net::SwarmMessage& m : *out) {
     Outgoing o;
     o.message = std::move(m);
@@ -281,8 +265,6 @@ void LiveDrone::Impl::QueueOutgoing(std::vector<net::SwarmMessage>* out) {
 
 void LiveDrone::Impl::EstimatorLoop() {
   std::deque<net::ReceivedMessage> pending;  // arrived after the current record
-  std::vector<swarm::DroneOutput> outputs;
-  std::vector<net::SwarmMessage> outgoing;
   const int64_t max_backlog_ns = static_cast<int64_t>(std::llround(options.max_scan_backlog_s * 1e9));
   while (std::optional<InputItem> item = input_queue->Pop()) {
     if (stop) break;
@@ -293,32 +275,32 @@ void LiveDrone::Impl::EstimatorLoop() {
       sink->OnScanDropped(s, ScanDropReason::kQueueFull);
       continue;
     }
-    const io::BagRecord& r = item->record;
+    io::BagRecord& r = item->record;
     if (const ImuSample* imu = r.imu()) {
-      Warn(estimator->AddImu(*imu));
-      Collect(&outputs);
+      loop->Add(*imu);
       ImuRatePose pose;
       if (options.imu_rate_odometry && imu_rate->AddImu(*imu, AccelerationFactor(), &pose)) {
         if (stats.imu_poses++ == 0) stats.first_imu_pose_ns = pose.stamp_ns;
         stats.last_imu_pose_ns = pose.stamp_ns;
         sink->OnImuPose(pose);
       }
-    } else if (const LidarScan* scan = r.scan()) {
+    } else if (LidarScan* scan = std::get_if<LidarScan>(&r.data)) {
       --scans_queued;
       const int64_t backlog_ns = mapping.ToSensorNs(setup.clock->NowNs()) - s;
       if (backlog_ns > max_backlog_ns) {
         ++stats.scans_dropped_backlog;
         sink->OnScanDropped(s, ScanDropReason::kBacklog);
+        loop->SendMessages();
       } else {
-        Warn(estimator->AddScan(*scan));
-        Collect(&outputs);
+        loop->Add(std::move(*scan));
       }
+    } else {
+      loop->SendMessages();  // a ground-truth pose: not for the component
     }
-    QueueOutgoing(&outgoing);
   }
-  Warn(estimator->Flush());
-  Collect(&outputs, /*at_flush=*/true);
-  QueueOutgoing(&outgoing);
+  flushing = true;
+  loop->Finish();
+  loop->SendMessages();
   estimator_done = true;
 }
 

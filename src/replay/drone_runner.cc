@@ -6,15 +6,13 @@
 
 namespace swarmlio::replay {
 
-Status DroneRunner::Create(const DroneInput& input, int drone_id,
+Status DroneRunner::Create(const driver::DroneInput& input, int drone_id,
                            std::unique_ptr<DroneRunner>* runner) {
   std::unique_ptr<DroneRunner> r(new DroneRunner());
   r->input_ = input;
-  r->drone_id_ = drone_id;
   Status status = io::BagReader::Open(input.bag_path, input.bag, &r->reader_);
   if (!status.ok()) return status.WithContext(input.name);
-  status = r->CreateEstimator(input.odometry.initialization);
-  if (!status.ok()) return status.WithContext(input.name);
+  SWARMLIO_RETURN_IF_ERROR(driver::DroneDriver::Create(input, drone_id, r.get(), &r->driver_));
   status = r->ReadNext();
   if (!status.ok()) return status.WithContext(input.name);
   if (input.restart_at_s > 0.0 && r->has_next_) {
@@ -81,34 +79,33 @@ ScanRecord ToScanRecord(const swarm::DroneOutput& o) {
   return r;
 }
 
-void DroneRunner::Deliver(const net::ReceivedMessage& message) {
-  Warn(estimator_->AddMessage(message));
+eval::CovariantTrajectory UpdatedEstimate(const std::vector<ScanRecord>& scans) {
+  eval::CovariantTrajectory out;
+  for (const ScanRecord& s : scans) {
+    if (!s.updated) continue;
+    Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+    T_G_b.linear() = s.state.q_G_b.normalized().toRotationMatrix();
+    T_G_b.translation() = s.state.p_b_in_G;
+    out.poses.stamps_s.push_back(StampSeconds(s.stamp_ns));
+    out.poses.T_G_b.push_back(T_G_b);
+    out.position_covariances.push_back(s.pose_covariance.bottomRightCorner<3, 3>());
+  }
+  return out;
 }
+
+void DroneRunner::Deliver(const net::ReceivedMessage& message) { driver_->Add(message); }
 
 void DroneRunner::TakeMessages(std::vector<net::SwarmMessage>* messages) {
-  estimator_->PopMessages(messages);
+  for (net::SwarmMessage& m : outbox_) messages->push_back(std::move(m));
+  outbox_.clear();
 }
 
-void DroneRunner::SetFusion(bool fuse) {
-  fuse_ = fuse;
-  estimator_->SetFusion(fuse);
-}
-
-Status DroneRunner::CreateEstimator(lio::InitializationMode initialization) {
-  swarm::DroneEstimatorOptions options;
-  options.odometry = input_.odometry;
-  options.odometry.initialization = initialization;
-  options.teammate = input_.teammate;
-  options.swarm = input_.swarm;
-  SWARMLIO_RETURN_IF_ERROR(
-      swarm::DroneEstimator::Create(drone_id_, options, input_.lidar, &estimator_));
-  estimator_->SetFusion(fuse_);
-  return Status::Ok();
-}
+void DroneRunner::SetFusion(bool fuse) { driver_->SetFusion(fuse); }
 
 Status DroneRunner::Restart() {
   restart_ns_ = -1;
-  SWARMLIO_RETURN_IF_ERROR(CreateEstimator(input_.restart_initialization));
+  outbox_.clear();
+  SWARMLIO_RETURN_IF_ERROR(driver_->Restart(input_.restart_initialization));
   const int64_t back_ns =
       next_.stamp_ns() + static_cast<int64_t>(std::llround(input_.restart_down_s * 1e9));
   while (has_next_ && next_.stamp_ns() < back_ns) SWARMLIO_RETURN_IF_ERROR(ReadNext());
@@ -128,12 +125,6 @@ Status DroneRunner::ReadNext() {
   return reader_->Next(&next_, &has_next_);
 }
 
-void DroneRunner::Warn(const Status& status) {
-  if (status.ok()) return;
-  if (warnings_.count == 0) warnings_.first = status.message();
-  ++warnings_.count;
-}
-
 Status DroneRunner::Step() {
   if (!has_next_) return Status::OutOfRange(input_.name + ": no record left");
   if (restart_ns_ >= 0 && next_.stamp_ns() >= restart_ns_) {
@@ -141,39 +132,39 @@ Status DroneRunner::Step() {
     // The record after the down time is fed at its own turn.
     return restarted.ok() ? restarted : restarted.WithContext(input_.name);
   }
-  if (const ImuSample* imu = next_.imu()) {
-    Warn(estimator_->AddImu(*imu));
-  } else if (const LidarScan* scan = next_.scan()) {
+  if (ImuSample* imu = std::get_if<ImuSample>(&next_.data)) {
+    driver_->Add(*imu);
+  } else if (LidarScan* scan = std::get_if<LidarScan>(&next_.data)) {
     // The live drone names a dropped scan by its record's stamp.
     if (std::binary_search(skip_scan_stamps_ns_.begin(), skip_scan_stamps_ns_.end(),
                            next_.stamp_ns())) {
       ++skipped_scans_;
+      driver_->SendMessages();
     } else {
-      Warn(estimator_->AddScan(*scan));
+      driver_->Add(std::move(*scan));  // the record is read anew below
     }
   } else if (const PoseStamped* pose = next_.ground_truth()) {
     ground_truth_.push_back(*pose);
+    driver_->SendMessages();
   }
-  Collect();
   const Status status = ReadNext();
   return status.ok() ? status : status.WithContext(input_.name);
 }
 
 Status DroneRunner::Finish() {
-  Warn(estimator_->Flush());
-  Collect();
+  driver_->Finish();
   return Status::Ok();
 }
 
-void DroneRunner::Collect() {
-  outputs_.clear();
-  estimator_->PopOutputs(&outputs_);
-  for (const swarm::DroneOutput& o : outputs_) {
+void DroneRunner::OnOutputs(const std::vector<swarm::DroneOutput>& outputs) {
+  for (const swarm::DroneOutput& o : outputs) {
     scans_.push_back(ToScanRecord(o));
     for (const swarm::IdentificationEvent& e : o.identifications) identifications_.push_back(e);
-    if (!o.ego.update_error.empty()) Warn(Status::Internal("update failed: " + o.ego.update_error));
-    if (!o.ego.front_end_error.empty()) Warn(Status::Internal("swarm front end: " + o.ego.front_end_error));
   }
+}
+
+void DroneRunner::OnMessages(std::vector<net::SwarmMessage>* messages) {
+  for (net::SwarmMessage& m : *messages) outbox_.push_back(std::move(m));
 }
 
 }  // namespace swarmlio::replay

@@ -16,14 +16,14 @@ double ReplayProgress::Fraction() const {
   return std::clamp(f, 0.0, 1.0);
 }
 
-Status SwarmReplay::Create(const SwarmManifest& manifest, std::unique_ptr<SwarmReplay>* replay) {
+Status SwarmReplay::Create(const driver::SwarmManifest& manifest, std::unique_ptr<SwarmReplay>* replay) {
   std::unique_ptr<SwarmReplay> r(new SwarmReplay());
   r->manifest_ = manifest;
   std::string errors;
   r->start_stamp_ns_ = std::numeric_limits<int64_t>::max();
   r->end_stamp_ns_ = std::numeric_limits<int64_t>::min();
   for (size_t i = 0; i < manifest.drones.size(); ++i) {
-    const DroneInput& input = manifest.drones[i];
+    const driver::DroneInput& input = manifest.drones[i];
     std::unique_ptr<DroneRunner> runner;
     const Status status = DroneRunner::Create(input, static_cast<int>(i), &runner);
     if (!status.ok()) {

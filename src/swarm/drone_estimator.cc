@@ -95,6 +95,12 @@ Status DroneEstimator::Create(int self_id, const DroneEstimatorOptions& options,
   return Status::Ok();
 }
 
+Status DroneEstimator::Add(const SensorRecord& record) {
+  if (const auto* imu = std::get_if<ImuSample>(&record)) return AddImu(*imu);
+  if (const auto* scan = std::get_if<LidarScan>(&record)) return AddScan(*scan);
+  return AddMessage(std::get<net::ReceivedMessage>(record));
+}
+
 Status DroneEstimator::AddImu(const ImuSample& sample) {
   if (sample.angular_velocity_rad_s.allFinite()) parts_->last_gyro = sample.angular_velocity_rad_s;
   parts_->now_ns = std::max(parts_->now_ns, sample.stamp_ns);

@@ -110,7 +110,7 @@ struct RacingDrone {
   std::unique_ptr<LiveDrone> drone;
 
   /// Creates and runs the drone; the first error of either step.
-  Status Run(const replay::DroneInput& input, const LiveOptions& options) {
+  Status Run(const driver::DroneInput& input, const LiveOptions& options) {
     Status s = net::SimulatedNetwork::Create(net::NetworkOptions(), {0, 1, 2}, &network);
     if (!s.ok()) return s;
     LiveSetup setup;
@@ -137,7 +137,7 @@ class SimulatedSwarmTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new swarmlio::testing::TempDir();
-    manifest_ = new replay::SwarmManifest();
+    manifest_ = new driver::SwarmManifest();
     ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
         std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "live",
         0.1 * kDurationDeciSeconds, dir_->path(), manifest_));
@@ -148,7 +148,7 @@ class SimulatedSwarmTest : public ::testing::Test {
   }
 
   static inline swarmlio::testing::TempDir* dir_ = nullptr;
-  static inline replay::SwarmManifest* manifest_ = nullptr;
+  static inline driver::SwarmManifest* manifest_ = nullptr;
 };
 
 class LiveSwarmTest : public SimulatedSwarmTest<static_cast<int>(kDurationS * 10)> {};

@@ -338,7 +338,7 @@ TEST(PushSource, ScansDroppedWholeImuNeverDropped) {
 // The drone's odometry fed its bag directly (no threads): each scan given
 // once the IMU has passed its stamp by `scan_delay_ns` (0: the bag's stamp
 // order), as kImuFirst releases a scan published that late.
-std::vector<lio::ScanOutput> RunOdometry(const replay::DroneInput& drone, int64_t scan_delay_ns,
+std::vector<lio::ScanOutput> RunOdometry(const driver::DroneInput& drone, int64_t scan_delay_ns,
                                          lio::OdometryCounters* counters) {
   std::vector<lio::ScanOutput> outputs;
   std::unique_ptr<lio::Odometry> odometry;
@@ -386,7 +386,7 @@ TEST(PushSource, OdometryOfTheImuFirstOrderEqualsTheStampOrders) {
   // the map, as in stamp order (lio.md step 7). Deterministic, unlike the
   // LiveDrone test below, whose consumer may lag and re-sort the buffer.
   swarmlio::testing::TempDir dir;
-  replay::SwarmManifest manifest;
+  driver::SwarmManifest manifest;
   ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
       std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "order", 4.0,
       dir.path(), &manifest));
@@ -419,12 +419,12 @@ class PushSourceOrdering : public ::testing::TestWithParam<PushOrdering> {};
 
 TEST_P(PushSourceOrdering, LiveDroneFedByPushesReproducesTheOfflineReplay) {
   swarmlio::testing::TempDir dir;
-  replay::SwarmManifest manifest;
+  driver::SwarmManifest manifest;
   ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
       std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "push", 6.0,
       dir.path(), &manifest));
   manifest.drones.resize(1);
-  const replay::DroneInput& drone = manifest.drones[0];
+  const driver::DroneInput& drone = manifest.drones[0];
   std::unique_ptr<replay::SwarmReplay> offline;
   Status s = replay::SwarmReplay::Create(manifest, &offline);
   ASSERT_TRUE(s.ok()) << s.message();

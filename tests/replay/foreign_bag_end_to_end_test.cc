@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "swarmlio/config/sensor_preset.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/io/bag_reader.h"
 #include "swarmlio/io/bag_writer.h"
 #include "swarmlio/math/so3.h"
-#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/swarm_replay.h"
 #include "swarmlio/sim/output_writer.h"
 #include "swarmlio/sim/scenario.h"
@@ -109,7 +109,7 @@ Status Rewrite(const std::string& in, const std::string& out, const io::BagWrite
 
 struct RunResult {
   double rmse_m = 0.0;  // vs the original ground truth (in G)
-  FrameCheck frame;
+  eval::FrameCheck frame;
   ImuInitialization init;
   io::ReadStats stats;
   std::string imu_topic, lidar_topic, ground_truth_topic;
@@ -154,8 +154,8 @@ class ForeignBagTest : public ::testing::Test {
 
   // A manifest entry as a newcomer would write it: the bag and the sensor
   // description; topics found by type ("" = auto), ground truth "auto".
-  static DroneInput Input(const SimDrone& d, const std::string& bag) {
-    DroneInput in;
+  static driver::DroneInput Input(const SimDrone& d, const std::string& bag) {
+    driver::DroneInput in;
     in.name = "uav1";
     in.bag_path = bag;
     in.lidar = d.lidar;
@@ -165,14 +165,14 @@ class ForeignBagTest : public ::testing::Test {
     in.bag.ground_truth_topic = io::kAutoTopic;
     in.bag.point_time_unit = d.lidar.timestamp_unit;
     in.bag.spinning_lidar = d.lidar.type == LidarType::kSpinning;
-    in.odometry = DefaultOdometryOptions(d.lidar, d.imu);
+    in.odometry = driver::DefaultOdometryOptions(d.lidar, d.imu);
     in.odometry.imu_time_offset_s = d.imu_time_offset_s;
     return in;
   }
 
-  static RunResult Run(const DroneInput& input, const std::vector<PoseStamped>& truth) {
+  static RunResult Run(const driver::DroneInput& input, const std::vector<PoseStamped>& truth) {
     RunResult result;
-    SwarmManifest manifest;
+    driver::SwarmManifest manifest;
     manifest.name = "foreign";
     manifest.drones = {input};
     std::unique_ptr<SwarmReplay> run;
@@ -188,12 +188,16 @@ class ForeignBagTest : public ::testing::Test {
     result.imu_topic = d.reader().imu_topic();
     result.lidar_topic = d.reader().lidar_topic();
     result.ground_truth_topic = d.reader().ground_truth_topic();
-    ConsistencyStats cs;
-    EXPECT_TRUE(EvaluateConsistency(d.scans(), truth, 0.05, &cs).ok());
+    eval::ConsistencyStats cs;
+    EXPECT_TRUE(eval::EvaluateConsistency(UpdatedEstimate(d.scans()),
+                                          eval::TrajectoryFromPoses(truth), 0.05, &cs)
+                    .ok());
     result.rmse_m = cs.position_rmse_m;
     if (!d.bag_ground_truth().empty()) {
-      EXPECT_TRUE(CheckGroundTruthFrame(d.scans(), d.bag_ground_truth(), input.ground_truth_frame,
-                                        FrameCheckOptions(), &result.frame)
+      EXPECT_TRUE(eval::CheckGroundTruthFrame(UpdatedEstimate(d.scans()).poses,
+                                              eval::TrajectoryFromPoses(d.bag_ground_truth()),
+                                              input.ground_truth_frame, eval::FrameCheckOptions(),
+                                              &result.frame)
                       .ok());
     }
     return result;
@@ -224,7 +228,7 @@ TEST_F(ForeignBagTest, SignFlippedImuAndForeignTopicsTrackLikeTheOriginal) {
   Edits flip;
   flip.flip_acceleration = true;
   ASSERT_TRUE(Rewrite(mid360_.bag, flipped_bag, same, flip).ok());
-  DroneInput flipped_input = Input(mid360_, flipped_bag);
+  driver::DroneInput flipped_input = Input(mid360_, flipped_bag);
   flipped_input.odometry.imu_init.acceleration_sign = 0;  // auto
   const RunResult flipped = Run(flipped_input, *truth_mid360_);
   EXPECT_EQ(flipped.init.reported_direction, SpecificForceDirection::kDown);
@@ -272,7 +276,7 @@ TEST_F(ForeignBagTest, SpinningCloudWithoutPointTimeTracksLikeTheOriginal) {
   EXPECT_EQ(reconstructed.stats.scans_point_time_from_azimuth,
             reconstructed.stats.scans_without_point_time);
 
-  DroneInput instant_input = Input(spinning_, no_time_bag);
+  driver::DroneInput instant_input = Input(spinning_, no_time_bag);
   instant_input.bag.reconstruct_point_time = io::PointTimeReconstruction::kNone;
   const RunResult instant = Run(instant_input, *truth_spinning_);
   EXPECT_EQ(instant.stats.scans_point_time_from_azimuth, 0);

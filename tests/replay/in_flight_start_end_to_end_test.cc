@@ -73,7 +73,7 @@ class InFlightStartTest : public ::testing::Test {
     dir_ = new fs::path(fs::temp_directory_path() /
                         ("swarmlio_in_flight_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
-    manifest_ = new SwarmManifest();
+    manifest_ = new driver::SwarmManifest();
     ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
         std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "indoor_3uav",
         kDurationS, *dir_, manifest_, nullptr, /*true_G_in_W=*/true));
@@ -91,8 +91,8 @@ class InFlightStartTest : public ::testing::Test {
                               double offset_s = kStartOffsetS,
                               int late = kLateJoiner,
                               bool restart = false) {
-    SwarmManifest manifest = *manifest_;
-    DroneInput& input = manifest.drones[late];
+    driver::SwarmManifest manifest = *manifest_;
+    driver::DroneInput& input = manifest.drones[late];
     if (restart) {
       input.restart_at_s = offset_s;
       input.restart_initialization = mode;
@@ -194,11 +194,11 @@ class InFlightStartTest : public ::testing::Test {
   }
 
   static fs::path* dir_;
-  static SwarmManifest* manifest_;
+  static driver::SwarmManifest* manifest_;
 };
 
 fs::path* InFlightStartTest::dir_ = nullptr;
-SwarmManifest* InFlightStartTest::manifest_ = nullptr;
+driver::SwarmManifest* InFlightStartTest::manifest_ = nullptr;
 
 void Print(const char* label, const LateDroneFigures& f, int late = kLateJoiner) {
   std::printf(

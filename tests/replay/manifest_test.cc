@@ -1,10 +1,10 @@
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-namespace swarmlio::replay {
+namespace swarmlio::driver {
 namespace {
 
 const std::string kPresets = std::string(SWARMLIO_SOURCE_DIR) + "/configs/";
@@ -94,5 +94,32 @@ TEST(Manifest, FromBags) {
   EXPECT_FALSE(ManifestFromBags({"x.bag", "y.bag"}, "", {"a", "a"}, &m).ok());
 }
 
+TEST(Manifest, KeyGroundTruthFrame) {
+  SwarmManifest manifest;
+  const Status status = ParseManifest(
+      "name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: G}\n"
+      "  - {name: b, bag: b.bag, ground_truth_frame: other}\n  - {name: c, bag: c.bag}\n",
+      "/tmp/m.yaml", &manifest);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(manifest.drones[0].ground_truth_frame, eval::GroundTruthFrame::kG);
+  EXPECT_EQ(manifest.drones[1].ground_truth_frame, eval::GroundTruthFrame::kOther);
+  EXPECT_EQ(manifest.drones[2].ground_truth_frame, eval::GroundTruthFrame::kAuto);
+  EXPECT_FALSE(ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: W}\n",
+                             "/tmp/m.yaml", &manifest)
+                   .ok());
+}
+
+TEST(Manifest, MarksSpinningLidars) {
+  SwarmManifest manifest;
+  const std::string preset = std::string(SWARMLIO_SOURCE_DIR) + "/configs/spinning_32.yaml";
+  ASSERT_TRUE(ManifestFromBags({"a.bag"}, preset, {}, &manifest).ok());
+  EXPECT_TRUE(manifest.drones[0].bag.spinning_lidar);
+  ASSERT_TRUE(ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, sensor_preset: " + preset +
+                                ", bag_topics: {spinning_lidar: false}}\n",
+                            "/tmp/m.yaml", &manifest)
+                  .ok());
+  EXPECT_FALSE(manifest.drones[0].bag.spinning_lidar);
+}
+
 }  // namespace
-}  // namespace swarmlio::replay
+}  // namespace swarmlio::driver

@@ -6,15 +6,15 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "swarmlio/driver/manifest.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/lio/odometry.h"
-#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/drone_runner.h"
-#include "swarmlio/replay/manifest.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
 
@@ -86,9 +86,11 @@ void LoadScenarioWithSeed(const std::string& name, int seed, sim::Scenario* scen
 
 // Runs drone `index` of `simulator` through the odometry with the calibration
 // the simulator hands over (with its error, not the truth).
-void RunWithGivenCalibration(sim::Simulator* simulator, const sim::DroneConfig& d, int index,
-                             replay::ConsistencyStats* consistency) {
-  lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+void RunWithGivenCalibration(sim::Simulator* simulator,
+                             const sim::DroneConfig& d,
+                             int index,
+                             eval::ConsistencyStats* consistency) {
+  lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
   const sim::SensorCalibration given = sim::GivenCalibration(d);
   options.imu_time_offset_s = given.imu_time_offset_s;
   LidarOptions lidar = d.lidar.sensor;
@@ -100,8 +102,10 @@ void RunWithGivenCalibration(sim::Simulator* simulator, const sim::DroneConfig& 
   sim::DroneStats stats;
   ASSERT_TRUE(simulator->RunDrone(index, &sink, &stats).ok());
   ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
-  ASSERT_TRUE(
-      replay::EvaluateConsistency(sink.scans, sink.ground_truth, 0.05, consistency).ok());
+  ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(sink.scans),
+                                        eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
+                                        consistency)
+                  .ok());
 }
 
 TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
@@ -123,7 +127,7 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
   for (const Case c : {Case{0, 0.02, 1.8}, Case{2, 0.06, 0.75}}) {
     const sim::DroneConfig& d = drones[c.drone];
     SCOPED_TRACE(d.name);
-    lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
     options.imu_time_offset_s = d.imu.time_offset_s;
     std::unique_ptr<lio::Odometry> odometry;
     ASSERT_TRUE(lio::Odometry::Create(options, d.lidar.sensor, &odometry).ok());
@@ -140,9 +144,11 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
       updated += s.updated ? 1 : 0;
     }
     EXPECT_GE(updated, static_cast<int>(sink.scans.size()) - 1);  // all but the map's first
-    replay::ConsistencyStats consistency;
-    ASSERT_TRUE(
-        replay::EvaluateConsistency(sink.scans, sink.ground_truth, 0.05, &consistency).ok());
+    eval::ConsistencyStats consistency;
+    ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(sink.scans),
+                                          eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
+                                          &consistency)
+                    .ok());
     std::printf("[ figures  ] %s: %d poses, position RMSE %.4f m, rotation RMSE %.3f deg, "
                 "mean position NEES %.2f\n",
                 d.name.c_str(), consistency.num_poses, consistency.position_rmse_m,
@@ -176,7 +182,7 @@ TEST(OdometryEndToEnd, StaticStartScansSeedTheMap) {
   const sim::DroneConfig& d = drones[2];  // uav3, Avia
   for (const bool seed : {true, false}) {
     SCOPED_TRACE(seed ? "seeded" : "not seeded");
-    lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
     options.imu_time_offset_s = d.imu.time_offset_s;
     options.seed_map_from_static_start = seed;
     std::unique_ptr<lio::Odometry> odometry;
@@ -186,9 +192,11 @@ TEST(OdometryEndToEnd, StaticStartScansSeedTheMap) {
     ASSERT_TRUE(simulator.RunDrone(2, &sink, &stats).ok());
     ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
     const lio::OdometryCounters& c = odometry->counters();
-    replay::ConsistencyStats consistency;
-    ASSERT_TRUE(
-        replay::EvaluateConsistency(sink.scans, sink.ground_truth, 0.05, &consistency).ok());
+    eval::ConsistencyStats consistency;
+    ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(sink.scans),
+                                          eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
+                                          &consistency)
+                    .ok());
     std::printf("[ figures  ] %s: %lld scans seeded the map, rotation RMSE %.3f deg\n",
                 seed ? "seeded" : "not seeded", static_cast<long long>(c.scans_seeding_map),
                 consistency.rotation_rmse_deg);
@@ -221,7 +229,7 @@ TEST(OdometryEndToEnd, ConsistentOnTheRealisticSimulatorOnAHeldOutSeed) {
   for (const Case c : {Case{0, 0.03}, Case{1, 0.03}, Case{2, 0.06}}) {
     const sim::DroneConfig& d = drones[c.drone];
     SCOPED_TRACE(d.name);
-    replay::ConsistencyStats consistency;
+    eval::ConsistencyStats consistency;
     RunWithGivenCalibration(&simulator, d, c.drone, &consistency);
     if (HasFatalFailure()) return;
     std::printf("[ figures  ] %s (realistic, seed 7, 40 s): position RMSE %.4f m, rotation RMSE "
@@ -232,7 +240,7 @@ TEST(OdometryEndToEnd, ConsistentOnTheRealisticSimulatorOnAHeldOutSeed) {
     EXPECT_LT(consistency.position_rmse_m, c.max_rmse_m);
     EXPECT_LT(consistency.mean_position_nees, 3.0 * 3.0);  // not overconfident
     // After the gauge alignment (the map's rotation about the start through
-    // the calibration error, replay/consistency.h): not overconfident either.
+    // the calibration error, eval/consistency.h): not overconfident either.
     // Its lower side is below the band on this small indoor flight for the
     // Avia (0.31 since session 15's map insertion, 0.34 before; uav2 2.36,
     // 0.73 before: the fitted rotation also takes up real errors over 2 m,

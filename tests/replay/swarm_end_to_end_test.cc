@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmlio/replay/consistency.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/replay/swarm_replay.h"
 #include "test_utils/simulated_swarm.h"
 
@@ -29,7 +29,7 @@ class SwarmEndToEndTest : public ::testing::Test {
     dir_ = new fs::path(fs::temp_directory_path() /
                         ("swarmlio_swarm_e2e_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
-    manifest_ = new SwarmManifest();
+    manifest_ = new driver::SwarmManifest();
     ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
         std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/wall_degenerate.yaml",
         "wall_degenerate", 36.0, *dir_, manifest_));
@@ -55,10 +55,11 @@ class SwarmEndToEndTest : public ::testing::Test {
     EXPECT_TRUE(run->Run(options).ok());
     std::vector<double> rmse;
     for (int i = 0; i < run->num_drones(); ++i) {
-      ConsistencyStats c;
-      EXPECT_TRUE(
-          EvaluateConsistency(run->drone(i).scans(), run->drone(i).bag_ground_truth(), 0.05, &c)
-              .ok());
+      eval::ConsistencyStats c;
+      EXPECT_TRUE(eval::EvaluateConsistency(
+                      UpdatedEstimate(run->drone(i).scans()),
+                      eval::TrajectoryFromPoses(run->drone(i).bag_ground_truth()), 0.05, &c)
+                      .ok());
       rmse.push_back(c.position_rmse_m);
       identified->push_back(static_cast<int>(run->drone(i).identifications().size()));
     }
@@ -66,11 +67,11 @@ class SwarmEndToEndTest : public ::testing::Test {
   }
 
   static fs::path* dir_;
-  static SwarmManifest* manifest_;
+  static driver::SwarmManifest* manifest_;
 };
 
 fs::path* SwarmEndToEndTest::dir_ = nullptr;
-SwarmManifest* SwarmEndToEndTest::manifest_ = nullptr;
+driver::SwarmManifest* SwarmEndToEndTest::manifest_ = nullptr;
 
 TEST_F(SwarmEndToEndTest, TeammatesKeepTheWallFacingAviaFromDrifting) {
   std::vector<int> identified_swarm, identified_single;
@@ -126,8 +127,8 @@ TEST_F(SwarmEndToEndTest, LateObservationsStillHoldTheWallFacingAvia) {
 TEST_F(SwarmEndToEndTest, RepeatedObservationsReplaceLostOnesAndNeverCountTwice) {
   using swarm::RepeatObservations;
   const auto run = [](double loss, RepeatObservations repeat) {
-    SwarmManifest manifest = *manifest_;
-    for (DroneInput& d : manifest.drones) {
+    driver::SwarmManifest manifest = *manifest_;
+    for (driver::DroneInput& d : manifest.drones) {
       d.swarm.repeat_observations = repeat;
       // The repeats' own mechanism, without the byte budget's choices (which
       // drop repeats when the observers are at their budget: docs/swarm.md
@@ -180,7 +181,7 @@ TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
   const fs::path dir =
       fs::temp_directory_path() / ("swarmlio_swarm_clock_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  SwarmManifest manifest;
+  driver::SwarmManifest manifest;
   const std::vector<double> offsets_s = {0.0, 0.5, -0.5};
   const std::vector<double> drifts_ppm = {0.0, 30.0, -20.0};
   ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
@@ -215,9 +216,10 @@ TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
       EXPECT_LT(std::abs(estimate.offset_ns - truth_ns), 2'000'000) << i << " -> " << j;
     }
   }
-  ConsistencyStats avia;
-  ASSERT_TRUE(EvaluateConsistency(run->drone(0).scans(), run->drone(0).bag_ground_truth(), 0.05,
-                                  &avia)
+  eval::ConsistencyStats avia;
+  ASSERT_TRUE(eval::EvaluateConsistency(UpdatedEstimate(run->drone(0).scans()),
+                                        eval::TrajectoryFromPoses(run->drone(0).bag_ground_truth()),
+                                        0.05, &avia)
                   .ok());
   std::printf("[ figures  ] wall-facing Avia with clocks 0.5 s apart: position RMSE %.4f m\n",
               avia.position_rmse_m);

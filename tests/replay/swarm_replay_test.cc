@@ -62,9 +62,9 @@ class SwarmReplayTest : public ::testing::Test {
     delete dir_;
   }
 
-  static SwarmManifest Manifest() {
-    SwarmManifest m;
-    EXPECT_TRUE(ManifestFromBags({(*dir_ / "uav1.bag").string(), (*dir_ / "uav2.bag").string()},
+  static driver::SwarmManifest Manifest() {
+    driver::SwarmManifest m;
+    EXPECT_TRUE(driver::ManifestFromBags({(*dir_ / "uav1.bag").string(), (*dir_ / "uav2.bag").string()},
                                  std::string(SWARMLIO_SOURCE_DIR) + "/configs/livox_mid360.yaml",
                                  {"uav1", "uav2"}, &m)
                     .ok());
@@ -217,7 +217,7 @@ TEST_F(SwarmReplayTest, DroppedScansFileIsReadOrRefusedByLine) {
 }
 
 TEST_F(SwarmReplayTest, BadInputsGiveClearErrors) {
-  SwarmManifest m = Manifest();
+  driver::SwarmManifest m = Manifest();
   m.drones[1].bag_path = (*dir_ / "missing.bag").string();
   std::unique_ptr<SwarmReplay> run;
   Status status = SwarmReplay::Create(m, &run);

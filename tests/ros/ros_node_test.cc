@@ -42,7 +42,7 @@
 #include <thread>
 #include <vector>
 
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
 #include "test_utils/free_port.h"
 #include "test_utils/temp_dir.h"
@@ -184,8 +184,8 @@ TEST_P(RosNodeTest, OdometryOverRosmasterEqualsOfflineReplay) {
   }
   // The reference: the offline replay of uav1 alone (registered clouds on,
   // as the node runs).
-  replay::SwarmManifest manifest;
-  Status s = replay::LoadManifest(root + "/sim/swarm.yaml", &manifest);
+  driver::SwarmManifest manifest;
+  Status s = driver::LoadManifest(root + "/sim/swarm.yaml", &manifest);
   ASSERT_TRUE(s.ok()) << s.message();
   ASSERT_GE(manifest.drones.size(), 1u);
   ASSERT_EQ(manifest.drones[0].name, "uav1");

@@ -22,7 +22,7 @@
 #include <variant>
 #include <vector>
 
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
 #include "swarmlio/swarm/drone_estimator.h"
@@ -48,7 +48,7 @@ inline sim::Scenario IndoorScenario() {
 
 inline DroneEstimatorOptions OptionsFor(const sim::DroneConfig& d) {
   DroneEstimatorOptions o;
-  o.odometry = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+  o.odometry = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
   o.odometry.imu_time_offset_s = d.imu.time_offset_s;
   // The sinks below hand over the teammate's states stamped on one clock
   // without TimeSync exchanges; clock synchronisation has its own test.

@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/sim/output_writer.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
@@ -26,7 +26,7 @@ namespace swarmlio::testing {
 /// each drone's true G in the simulation world fills R_W_G / p_G_in_W_m.
 inline ::testing::AssertionResult SimulateSwarm(
     const std::string& scenario_path, const std::string& name, double duration_s,
-    const std::filesystem::path& dir, replay::SwarmManifest* manifest,
+    const std::filesystem::path& dir, driver::SwarmManifest* manifest,
     const std::function<void(sim::Scenario*)>& edit = nullptr, bool true_G_in_W = false) {
   sim::Scenario scenario;
   const Status loaded = sim::LoadScenario(scenario_path, &scenario);
@@ -46,13 +46,13 @@ inline ::testing::AssertionResult SimulateSwarm(
                                      sim::BagOptionsFor(scenario.bag, d.lidar.sensor), &writers[i]);
     if (!opened.ok()) return ::testing::AssertionFailure() << opened.message();
     sinks.push_back(writers[i].get());
-    replay::DroneInput input;
+    driver::DroneInput input;
     input.name = d.name;
     input.bag_path = stem + ".bag";
     input.lidar = d.lidar.sensor;
     input.imu = d.imu.sensor;
     input.bag.point_time_unit = d.lidar.sensor.timestamp_unit;
-    input.odometry = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    input.odometry = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
     input.odometry.imu_time_offset_s = d.imu.time_offset_s;  // as if calibrated
     input.true_clock.offset_s = d.clock_offset_s;  // packet delivery only
     input.true_clock.drift_ppm = d.clock_drift_ppm;

@@ -27,11 +27,11 @@
 #include <utility>
 #include <vector>
 
+#include "swarmlio/driver/manifest.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/lio/odometry.h"
 #include "swarmlio/math/so3.h"
-#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/drone_runner.h"
-#include "swarmlio/replay/manifest.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
 
@@ -105,7 +105,7 @@ Simulation Indoor(double duration_s) {
 }
 
 lio::OdometryOptions Options(const sim::DroneConfig& d, lio::EstimatorKind estimator, int size) {
-  lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+  lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
   options.imu_time_offset_s = d.imu.time_offset_s;
   options.estimator = estimator;
   options.window.size = size;
@@ -196,8 +196,11 @@ TEST(WindowOdometry, WindowOfFiveTracksAShortIndoorFlight) {
     int updated = 0;
     for (const auto& s : scans) updated += s.updated ? 1 : 0;
     EXPECT_GE(updated, static_cast<int>(scans.size()) - 1);
-    replay::ConsistencyStats consistency;
-    ASSERT_TRUE(replay::EvaluateConsistency(scans, sink.ground_truth, 0.05, &consistency).ok());
+    eval::ConsistencyStats consistency;
+    ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(scans),
+                                          eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
+                                          &consistency)
+                    .ok());
     std::printf("[ figures  ] %s, %s: position RMSE %.4f m, rotation RMSE %.3f deg, mean "
                 "position NEES %.2f\n",
                 d.name.c_str(), name, consistency.position_rmse_m, consistency.rotation_rmse_deg,
@@ -242,8 +245,8 @@ TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
       "  - name: b\n"
       "    bag: b.bag\n"
       "    sensor_preset: " + presets + "livox_avia.yaml\n";
-  replay::SwarmManifest m;
-  const Status status = replay::ParseManifest(yaml, "/data/swarm.yaml", &m);
+  driver::SwarmManifest m;
+  const Status status = driver::ParseManifest(yaml, "/data/swarm.yaml", &m);
   ASSERT_TRUE(status.ok()) << status.message();
   ASSERT_EQ(m.drones.size(), 2u);
   EXPECT_EQ(m.drones[0].odometry.estimator, lio::EstimatorKind::kWindow);
@@ -258,7 +261,7 @@ TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
       "  - name: a\n"
       "    bag: a.bag\n"
       "    odometry: {estimator: smoother}\n";
-  const Status refused = replay::ParseManifest(bad, "/data/swarm.yaml", &m);
+  const Status refused = driver::ParseManifest(bad, "/data/swarm.yaml", &m);
   EXPECT_FALSE(refused.ok());
   EXPECT_NE(refused.message().find("estimator"), std::string::npos) << refused.message();
 }

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/math/so3.h"
-#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/swarm_replay.h"
 #include "test_utils/simulated_swarm.h"
 
@@ -38,7 +38,7 @@ class WindowSwarmTest : public ::testing::Test {
     dir_ = new fs::path(fs::temp_directory_path() /
                         ("swarmlio_window_swarm_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
-    manifest_ = new SwarmManifest();
+    manifest_ = new driver::SwarmManifest();
     ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
         std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "indoor_3uav", 22.0, *dir_,
         manifest_));
@@ -51,8 +51,8 @@ class WindowSwarmTest : public ::testing::Test {
   }
 
   static std::vector<DroneRun> Run(lio::EstimatorKind estimator, int window_size) {
-    SwarmManifest manifest = *manifest_;
-    for (DroneInput& d : manifest.drones) {
+    driver::SwarmManifest manifest = *manifest_;
+    for (driver::DroneInput& d : manifest.drones) {
       d.odometry.estimator = estimator;
       d.odometry.window.size = window_size;
     }
@@ -64,8 +64,11 @@ class WindowSwarmTest : public ::testing::Test {
       const DroneRunner& d = run->drone(i);
       DroneRun r;
       r.scans = d.scans();
-      ConsistencyStats c;
-      EXPECT_TRUE(EvaluateConsistency(d.scans(), d.bag_ground_truth(), 0.05, &c).ok());
+      eval::ConsistencyStats c;
+      EXPECT_TRUE(eval::EvaluateConsistency(UpdatedEstimate(d.scans()),
+                                            eval::TrajectoryFromPoses(d.bag_ground_truth()), 0.05,
+                                            &c)
+                      .ok());
       r.position_rmse_m = c.position_rmse_m;
       r.identified = static_cast<int>(d.identifications().size());
       for (const ScanRecord& s : d.scans()) r.fused += s.active_observations + s.passive_observations;
@@ -75,11 +78,11 @@ class WindowSwarmTest : public ::testing::Test {
   }
 
   static fs::path* dir_;
-  static SwarmManifest* manifest_;
+  static driver::SwarmManifest* manifest_;
 };
 
 fs::path* WindowSwarmTest::dir_ = nullptr;
-SwarmManifest* WindowSwarmTest::manifest_ = nullptr;
+driver::SwarmManifest* WindowSwarmTest::manifest_ = nullptr;
 
 // Largest difference of the teammate extrinsics between two runs over the
 // scans where both estimate the same teammate [m], [deg].

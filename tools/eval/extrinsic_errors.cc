@@ -12,7 +12,7 @@
 namespace swarmlio::tools {
 namespace {
 
-int IndexOf(const replay::SwarmManifest& manifest, const std::string& name) {
+int IndexOf(const driver::SwarmManifest& manifest, const std::string& name) {
   for (size_t i = 0; i < manifest.drones.size(); ++i) {
     if (manifest.drones[i].name == name) return static_cast<int>(i);
   }
@@ -22,7 +22,7 @@ int IndexOf(const replay::SwarmManifest& manifest, const std::string& name) {
 }  // namespace
 
 Status EvaluateExtrinsicErrors(const std::string& csv_path,
-                               const replay::SwarmManifest& manifest,
+                               const driver::SwarmManifest& manifest,
                                const std::string& observer,
                                const std::map<std::string, double>& origins,
                                std::vector<ExtrinsicErrorRow>* rows) {
@@ -31,11 +31,11 @@ Status EvaluateExtrinsicErrors(const std::string& csv_path,
   if (i < 0) return Status::NotFound("observer '" + observer + "' is not a drone of the manifest");
   // Each drone's global frame in the simulation world.
   std::vector<Eigen::Isometry3d> T_W_Gs;
-  for (const replay::DroneInput& d : manifest.drones) T_W_Gs.push_back(d.T_W_G());
+  for (const driver::DroneInput& d : manifest.drones) T_W_Gs.push_back(d.T_W_G());
   for (const auto& [name, stamp_s] : origins) {
     const int k = IndexOf(manifest, name);
     if (k < 0) return Status::NotFound("origin for '" + name + "': not a drone of the manifest");
-    const replay::DroneInput& d = manifest.drones[static_cast<size_t>(k)];
+    const driver::DroneInput& d = manifest.drones[static_cast<size_t>(k)];
     if (d.ground_truth_path.empty()) {
       return Status::FailedPrecondition(name + ": an origin needs its ground truth file");
     }

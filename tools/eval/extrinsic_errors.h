@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "swarmlio/common/status.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 namespace swarmlio::tools {
 
@@ -33,7 +33,7 @@ struct ExtrinsicErrorRow {
 /// stamp (the IMU initialization, docs/conventions.md), taken from their
 /// ground-truth TUM file: name -> stamp [s, the drone's clock].
 Status EvaluateExtrinsicErrors(const std::string& csv_path,
-                               const replay::SwarmManifest& manifest,
+                               const driver::SwarmManifest& manifest,
                                const std::string& observer,
                                const std::map<std::string, double>& origins,
                                std::vector<ExtrinsicErrorRow>* rows);

@@ -30,7 +30,7 @@
 #include "swarmlio/eval/plots.h"
 #include "swarmlio/eval/rpe.h"
 #include "swarmlio/eval/trajectory_io.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "extrinsic_errors.h"
 
 DEFINE_string(format, "tum", "format of sources given as a plain path: tum, kitti or euroc");
@@ -179,8 +179,8 @@ int main(int argc, char** argv) {
     if (FLAGS_manifest.empty() || FLAGS_observer.empty()) {
       return Usage("extrinsics needs --manifest and --observer");
     }
-    swarmlio::replay::SwarmManifest manifest;
-    Status status = swarmlio::replay::LoadManifest(FLAGS_manifest, &manifest);
+    swarmlio::driver::SwarmManifest manifest;
+    Status status = swarmlio::driver::LoadManifest(FLAGS_manifest, &manifest);
     if (!status.ok()) return Fail(status.message());
     std::map<std::string, double> origins;
     std::stringstream list(FLAGS_origins);

@@ -44,7 +44,7 @@ std::vector<std::string> Split(const std::string& s, char separator) {
   return out;
 }
 
-Status ParsePeers(const std::string& text, const replay::SwarmManifest& manifest,
+Status ParsePeers(const std::string& text, const driver::SwarmManifest& manifest,
                   std::vector<net::UdpPeer>* peers) {
   for (const std::string& item : Split(text, ',')) {
     const size_t eq = item.find('=');
@@ -76,7 +76,7 @@ Status ParsePeers(const std::string& text, const replay::SwarmManifest& manifest
 namespace {
 
 /// --initialization overrides the drone's odometry.initialization.
-Status ApplyInitializationFlag(replay::DroneInput* drone) {
+Status ApplyInitializationFlag(driver::DroneInput* drone) {
   if (!FLAGS_initialization.empty() &&
       !config::EnumFromString(FLAGS_initialization, &drone->odometry.initialization)) {
     return Status::InvalidArgument("--initialization: '" + FLAGS_initialization +
@@ -87,11 +87,11 @@ Status ApplyInitializationFlag(replay::DroneInput* drone) {
 
 }  // namespace
 
-Status LoadDroneFromFlags(LiveInput input, replay::DroneInput* drone, int* drone_id,
-                          replay::SwarmManifest* manifest) {
+Status LoadDroneFromFlags(LiveInput input, driver::DroneInput* drone, int* drone_id,
+                          driver::SwarmManifest* manifest) {
   if (!FLAGS_manifest.empty()) {
     if (FLAGS_drone.empty()) return Status::InvalidArgument("--manifest needs --drone=<name>");
-    SWARMLIO_RETURN_IF_ERROR(replay::LoadManifest(FLAGS_manifest, manifest));
+    SWARMLIO_RETURN_IF_ERROR(driver::LoadManifest(FLAGS_manifest, manifest));
     for (size_t i = 0; i < manifest->drones.size(); ++i) {
       if (manifest->drones[i].name == FLAGS_drone) {
         *drone = manifest->drones[i];
@@ -110,13 +110,13 @@ Status LoadDroneFromFlags(LiveInput input, replay::DroneInput* drone, int* drone
   const std::string name =
       FLAGS_name.empty() ? "uav" + std::to_string(FLAGS_drone_id + 1) : FLAGS_name;
   SWARMLIO_RETURN_IF_ERROR(
-      replay::ManifestFromBags({FLAGS_bag}, FLAGS_sensor_preset, {name}, manifest));
+      driver::ManifestFromBags({FLAGS_bag}, FLAGS_sensor_preset, {name}, manifest));
   *drone = manifest->drones[0];
   *drone_id = FLAGS_drone_id;
   return ApplyInitializationFlag(drone);
 }
 
-Status UdpOptionsFromFlags(const replay::SwarmManifest& manifest, net::UdpOptions* udp) {
+Status UdpOptionsFromFlags(const driver::SwarmManifest& manifest, net::UdpOptions* udp) {
   if (!config::EnumFromString(FLAGS_udp_mode, &udp->mode)) {
     return Status::InvalidArgument("--udp_mode=" + FLAGS_udp_mode + ": expected one of " +
                                    config::EnumChoices<net::UdpMode>());

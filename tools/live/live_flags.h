@@ -13,7 +13,7 @@
 #include "swarmlio/live/live_options.h"
 #include "swarmlio/net/swarm_key.h"
 #include "swarmlio/net/udp_transport.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 DECLARE_string(manifest);
 DECLARE_string(drone);
@@ -41,11 +41,11 @@ enum class LiveInput { kBag, kTopics };
 
 /// The drone from --manifest/--drone, or --bag (kBag) / --sensor_preset with
 /// --drone_id and --name. `manifest` holds every drone (names for --peers).
-Status LoadDroneFromFlags(LiveInput input, replay::DroneInput* drone, int* drone_id,
-                          replay::SwarmManifest* manifest);
+Status LoadDroneFromFlags(LiveInput input, driver::DroneInput* drone, int* drone_id,
+                          driver::SwarmManifest* manifest);
 
 /// --udp_mode, --port, --peers (ids or names of `manifest`), ... validated.
-Status UdpOptionsFromFlags(const replay::SwarmManifest& manifest, net::UdpOptions* udp);
+Status UdpOptionsFromFlags(const driver::SwarmManifest& manifest, net::UdpOptions* udp);
 
 /// --key_file (required).
 Status SwarmKeyFromFlags(net::SwarmKey* key);

@@ -28,7 +28,7 @@
 #include "swarmlio/live/live_drone.h"
 #include "swarmlio/live/steady_clock.h"
 #include "swarmlio/net/udp_transport.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 DEFINE_double(rate, 1.0, "playback speed (1 = real time)");
 DEFINE_double(start_s, 0.0, "skip the log's first seconds (a drone joining late or restarting)");
@@ -59,8 +59,8 @@ int Main() {
                  "[--rate=1]\n");
     return 2;
   }
-  replay::SwarmManifest manifest;
-  replay::DroneInput drone;
+  driver::SwarmManifest manifest;
+  driver::DroneInput drone;
   int drone_id = 0;
   Status status = LoadDroneFromFlags(LiveInput::kBag, &drone, &drone_id, &manifest);
   if (!status.ok()) return Fail(status);
@@ -84,7 +84,7 @@ int Main() {
   if (!status.ok()) return Fail(status);
   std::unique_ptr<LiveOutputs> outputs;
   std::vector<std::string> drone_names;
-  for (const replay::DroneInput& d : manifest.drones) drone_names.push_back(d.name);
+  for (const driver::DroneInput& d : manifest.drones) drone_names.push_back(d.name);
   status = LiveOutputs::Open(FLAGS_output_dir, drone.name, FLAGS_imu_odom, drone_names, &outputs);
   if (!status.ok()) return Fail(status);
   live::SteadyClock clock;

@@ -8,12 +8,12 @@
 #include <sstream>
 #include <vector>
 
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/eval/drone_metrics.h"
 #include "swarmlio/eval/error_statistics.h"
 #include "swarmlio/eval/plots.h"
 #include "swarmlio/eval/trajectory_io.h"
 #include "swarmlio/io/pcd_writer.h"
-#include "swarmlio/replay/consistency.h"
 
 namespace swarmlio::tools {
 namespace {
@@ -30,18 +30,6 @@ eval::Trajectory EstimateTrajectory(const std::vector<replay::ScanRecord>& scans
     t.T_G_b.push_back(T);
   }
   return t;
-}
-
-std::vector<PoseStamped> ToPoses(const eval::Trajectory& t) {
-  std::vector<PoseStamped> out;
-  for (size_t i = 0; i < t.size(); ++i) {
-    PoseStamped p;
-    p.stamp_ns = static_cast<int64_t>(std::llround(t.stamps_s[i] * 1e9));
-    p.q_G_b = Eigen::Quaterniond(t.T_G_b[i].linear());
-    p.p_b_in_G = t.T_G_b[i].translation();
-    out.push_back(p);
-  }
-  return out;
 }
 
 Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord>& scans) {
@@ -88,7 +76,7 @@ Status WriteNetwork(const std::string& path, const replay::SwarmReplay& run) {
 }
 
 // Moves plotted positions from a drone's G into the common frame W.
-Eigen::Matrix3Xd ToWorld(const replay::DroneInput& d, const Eigen::Matrix3Xd& p_in_G) {
+Eigen::Matrix3Xd ToWorld(const driver::DroneInput& d, const Eigen::Matrix3Xd& p_in_G) {
   Eigen::Matrix3Xd out = d.R_W_G * p_in_G;
   out.colwise() += d.p_G_in_W_m;
   return out;
@@ -163,20 +151,20 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
         errors.push_back(eval::ErrorSeriesFromApe(name, ape));
         // NEES only when the ground truth is in the estimator's G (declared, or
         // starting at the estimate's first pose): in another frame it is meaningless.
-        const std::vector<PoseStamped> truth = ToPoses(reference);
-        replay::FrameCheck frame;
-        if (replay::CheckGroundTruthFrame(d.scans(), truth, d.input().ground_truth_frame,
-                                          replay::FrameCheckOptions(), &frame)
+        const eval::CovariantTrajectory updated = replay::UpdatedEstimate(d.scans());
+        eval::FrameCheck frame;
+        if (eval::CheckGroundTruthFrame(updated.poses, reference, d.input().ground_truth_frame,
+                                        eval::FrameCheckOptions(), &frame)
                 .ok()) {
           extra.push_back({"ground_truth_frame",
                            std::string(frame.same_frame
                                            ? "G"
                                            : "other: aligned by first pose and SE(3)")});
-          replay::ConsistencyStats consistency;
+          eval::ConsistencyStats consistency;
           if (!frame.same_frame) {
             extra.push_back({"nees_position", std::string("n/a (frames differ)")});
             extra.push_back({"nees_position_aligned", std::string("n/a (frames differ)")});
-          } else if (replay::EvaluateConsistency(d.scans(), truth, 0.05, &consistency).ok()) {
+          } else if (eval::EvaluateConsistency(updated, reference, 0.05, &consistency).ok()) {
             extra.push_back({"nees_position", consistency.mean_position_nees});
             if (std::isfinite(consistency.mean_position_nees_aligned)) {
               extra.push_back({"nees_position_aligned", consistency.mean_position_nees_aligned});

@@ -110,7 +110,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
         m.extrinsic_max_m = std::max(m.extrinsic_max_m, e_m);
         m.extrinsic_max_deg = std::max(m.extrinsic_max_deg, e_deg);
         // j's ground truth is stamped in j's clock: the same true instant.
-        const replay::TrueClock& clock_j = run.drone(r.drone_id).input().true_clock;
+        const driver::TrueClock& clock_j = run.drone(r.drone_id).input().true_clock;
         const double t_j = StampSeconds(clock_j.ToDrone(d.input().true_clock.ToTrue(s.stamp_ns)));
         Eigen::Isometry3d T_true_Gj_bj;
         if (r.have_pose && has_truth[r.drone_id] &&

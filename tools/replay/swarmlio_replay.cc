@@ -28,11 +28,11 @@
 #include "report.h"
 #include "swarm_report.h"
 #include "swarmlio/config/config_file.h"
+#include "swarmlio/driver/manifest.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/eval/error_statistics.h"
 #include "swarmlio/net/swarm_key_file.h"
-#include "swarmlio/replay/consistency.h"
 #include "swarmlio/replay/dropped_scans.h"
-#include "swarmlio/replay/manifest.h"
 #include "swarmlio/replay/swarm_replay.h"
 
 DEFINE_string(manifest, "", "swarm manifest YAML (docs/replay.md); or use --bags");
@@ -126,8 +126,8 @@ Status ApplyReceivedPacketFlags(replay::ReplayOptions* options) {
 }
 
 // The back-end flags, applied to every drone's odometry options.
-Status ApplyEstimatorFlags(replay::SwarmManifest* manifest) {
-  for (replay::DroneInput& d : manifest->drones) {
+Status ApplyEstimatorFlags(driver::SwarmManifest* manifest) {
+  for (driver::DroneInput& d : manifest->drones) {
     lio::OdometryOptions& o = d.odometry;
     if (!FLAGS_estimator.empty() && !config::EnumFromString(FLAGS_estimator, &o.estimator)) {
       return Status::InvalidArgument("--estimator=" + FLAGS_estimator + ": expected one of " +
@@ -228,19 +228,18 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
   }
   if (!d.bag_ground_truth().empty()) {
     // NEES only when the ground truth is known to be in G (docs/replay.md).
-    replay::FrameCheck frame;
-    replay::ConsistencyStats cs;
-    std::vector<PoseStamped> aligned;
-    Status status = replay::CheckGroundTruthFrame(d.scans(), d.bag_ground_truth(),
-                                                  d.input().ground_truth_frame,
-                                                  replay::FrameCheckOptions(), &frame);
+    const eval::CovariantTrajectory estimate = replay::UpdatedEstimate(d.scans());
+    const eval::Trajectory truth = eval::TrajectoryFromPoses(d.bag_ground_truth());
+    eval::FrameCheck frame;
+    eval::ConsistencyStats cs;
+    eval::Trajectory aligned;
+    Status status = eval::CheckGroundTruthFrame(estimate.poses, truth, d.input().ground_truth_frame,
+                                                eval::FrameCheckOptions(), &frame);
     if (status.ok() && !frame.same_frame) {
-      status = replay::AlignGroundTruthByFirstPose(d.scans(), d.bag_ground_truth(), frame, 0.05,
-                                                   &aligned);
+      status = eval::AlignGroundTruthByFirstPose(estimate.poses, truth, frame, 0.05, &aligned);
     }
     if (status.ok()) {
-      status = replay::EvaluateConsistency(
-          d.scans(), frame.same_frame ? d.bag_ground_truth() : aligned, 0.05, &cs);
+      status = eval::EvaluateConsistency(estimate, frame.same_frame ? truth : aligned, 0.05, &cs);
     }
     if (status.ok()) {
       std::printf("  %s\n", frame.Summary().c_str());
@@ -291,11 +290,11 @@ int Main() {
                  "[--sensor_preset=FILE] [--names=a,b]) --output_dir=DIR\n");
     return 2;
   }
-  replay::SwarmManifest manifest;
+  driver::SwarmManifest manifest;
   Status status = FLAGS_manifest.empty()
-                      ? replay::ManifestFromBags(Split(FLAGS_bags), FLAGS_sensor_preset,
+                      ? driver::ManifestFromBags(Split(FLAGS_bags), FLAGS_sensor_preset,
                                                  Split(FLAGS_names), &manifest)
-                      : replay::LoadManifest(FLAGS_manifest, &manifest);
+                      : driver::LoadManifest(FLAGS_manifest, &manifest);
   if (!status.ok()) {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());
     return 1;

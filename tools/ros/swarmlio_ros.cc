@@ -97,8 +97,8 @@ std::string InputSummary(const RosInput& input, const live::PushSource& source,
 }
 
 int Main() {
-  replay::SwarmManifest manifest;
-  replay::DroneInput drone;
+  driver::SwarmManifest manifest;
+  driver::DroneInput drone;
   int drone_id = 0;
   Status status = LoadDroneFromFlags(LiveInput::kTopics, &drone, &drone_id, &manifest);
   if (!status.ok()) return Fail(status);
@@ -142,7 +142,7 @@ int Main() {
   status = net::UdpTransport::Create(udp_options, drone_id, &udp);
   if (!status.ok()) return Fail(status);
   std::vector<std::string> drone_names;
-  for (const replay::DroneInput& d : manifest.drones) drone_names.push_back(d.name);
+  for (const driver::DroneInput& d : manifest.drones) drone_names.push_back(d.name);
   if (static_cast<size_t>(drone_id) >= drone_names.size()) {
     drone_names.resize(static_cast<size_t>(drone_id) + 1);
     drone_names[static_cast<size_t>(drone_id)] = drone.name;

@@ -8,7 +8,7 @@
 #include <random>
 
 #include "swarmlio/lio/odometry.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 namespace swarmlio::teammate::harness {
 namespace {
@@ -272,7 +272,7 @@ Status EstimateEgoTrajectories(const sim::Simulator& sim,
     // The calibration handed to the estimator (with the scenario's error), as
     // a real drone's swarm.yaml would be: not the truth the simulator uses.
     out.calibration = sim::GivenCalibration(d);
-    lio::OdometryOptions options = replay::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
     options.imu_time_offset_s = out.calibration.imu_time_offset_s;
     LidarOptions lidar = d.lidar.sensor;
     lidar.R_imu_lidar = out.calibration.R_imu_lidar;

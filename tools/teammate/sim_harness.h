@@ -65,7 +65,7 @@ struct EstimatedTrajectory {
   static constexpr int64_t kMaxExtrapolationNs = 1000000;  // 1 ms
 };
 
-/// Runs lio::Odometry (replay::DefaultOdometryOptions, the given
+/// Runs lio::Odometry (driver::DefaultOdometryOptions, the given
 /// calibration) over every drone's simulated data (Simulator::Run, drones in
 /// parallel) and keeps its per-scan outputs; (*trajectories)[j] is drone j's.
 Status EstimateEgoTrajectories(const sim::Simulator& sim,

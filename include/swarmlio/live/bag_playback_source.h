@@ -9,7 +9,7 @@
 
 #include "swarmlio/io/bag_reader.h"
 #include "swarmlio/live/record_source.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 namespace swarmlio::live {
 
@@ -18,7 +18,7 @@ class BagPlaybackSource : public RecordSource {
   /// Opens the drone's bag and reads its first record; start_offset_s > 0
   /// skips the log's first seconds (a late join, a restart mid-flight).
   /// Errors name the drone and the file.
-  static Status Open(const replay::DroneInput& drone, double start_offset_s, const Clock* clock,
+  static Status Open(const driver::DroneInput& drone, double start_offset_s, const Clock* clock,
                      std::unique_ptr<BagPlaybackSource>* source);
 
   Status Start(SourceStart* start, bool* has_record) override;

@@ -2,7 +2,8 @@
 // takes the drone's sensor records from a RecordSource (record_source.h):
 // its bag played at `rate` x real time against an injected Clock
 // (BagPlaybackSource, the default), or records pushed by a driver such as the
-// ROS node (PushSource); runs its swarm::DroneEstimator and talks to the
+// ROS node (PushSource); runs its swarm::DroneEstimator through the drivers'
+// one loop (driver::DroneDriver) and talks to the
 // teammates through a real net::Transport (UdpTransport), with three threads:
 //
 //   input      takes each record from the source when it is due (bag:
@@ -38,13 +39,13 @@
 #include "swarmlio/net/message_channel.h"
 #include "swarmlio/net/swarm_key.h"
 #include "swarmlio/net/transport.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 #include "swarmlio/swarm/drone_estimator.h"
 
 namespace swarmlio::live {
 
 struct LiveSetup {
-  replay::DroneInput drone;  // bag (unless `source`), sensors, estimator options
+  driver::DroneInput drone;  // bag (unless `source`), sensors, estimator options
   int drone_id = 0;          // swarm id (index in the manifest; the same on every drone)
   net::SwarmKey key;         // the swarm's pre-shared key
   net::Transport* transport = nullptr;  // not owned; used by the network thread only

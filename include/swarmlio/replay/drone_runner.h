@@ -1,6 +1,7 @@
 // DroneRunner: one drone of an offline replay. It owns the drone's bag
-// reader and estimator; the replay loop asks for the stamp of its next record
-// and lets it consume that record (so N drones interleave in stamp order).
+// reader and its driver::DroneDriver (the component); the replay loop asks
+// for the stamp of its next record and lets it consume that record (so N
+// drones interleave in stamp order).
 // It keeps per-scan results (bounded: a few hundred bytes a scan) and the
 // ground truth found in the bag.
 #pragma once
@@ -12,9 +13,11 @@
 #include <vector>
 
 #include "swarmlio/common/status.h"
+#include "swarmlio/driver/drone_driver.h"
+#include "swarmlio/driver/manifest.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/io/bag_reader.h"
 #include "swarmlio/lio/odometry.h"
-#include "swarmlio/replay/manifest.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/swarm/drone_estimator.h"
 
@@ -62,16 +65,15 @@ struct ScanRecord {
 ScanRecord ToScanRecord(const lio::ScanOutput& output);
 ScanRecord ToScanRecord(const swarm::DroneOutput& output);
 
-struct DroneWarnings {
-  int64_t count = 0;
-  std::string first;  // the first warning's message
-};
+/// The updated scans' poses with their position covariances (the estimate
+/// eval::EvaluateConsistency and eval::CheckGroundTruthFrame take).
+eval::CovariantTrajectory UpdatedEstimate(const std::vector<ScanRecord>& scans);
 
-class DroneRunner {
+class DroneRunner : private driver::DriverSink {
  public:
   /// Opens the bag and creates the estimator. Errors name the drone.
   /// `drone_id`: the drone's index in the manifest (its swarm id).
-  static Status Create(const DroneInput& input, int drone_id, std::unique_ptr<DroneRunner>* runner);
+  static Status Create(const driver::DroneInput& input, int drone_id, std::unique_ptr<DroneRunner>* runner);
 
   /// True while the bag has records left (after Prime()).
   bool has_next() const { return has_next_; }
@@ -100,13 +102,13 @@ class DroneRunner {
     return identifications_;
   }
 
-  const DroneInput& input() const { return input_; }
+  const driver::DroneInput& input() const { return input_; }
   const std::vector<ScanRecord>& scans() const { return scans_; }
   const std::vector<PoseStamped>& bag_ground_truth() const { return ground_truth_; }
-  const lio::Odometry& odometry() const { return estimator_->odometry(); }
-  const swarm::DroneEstimator& estimator() const { return *estimator_; }
+  const lio::Odometry& odometry() const { return driver_->estimator().odometry(); }
+  const swarm::DroneEstimator& estimator() const { return driver_->estimator(); }
   const io::BagReader& reader() const { return *reader_; }
-  const DroneWarnings& warnings() const { return warnings_; }
+  const driver::DroneWarnings& warnings() const { return driver_->warnings(); }
 
  private:
   DroneRunner() = default;
@@ -114,25 +116,22 @@ class DroneRunner {
   // The restart of DroneInput::restart_at_s: a new estimator, the records of
   // the down time skipped, the outputs of the first session dropped.
   Status Restart();
-  Status CreateEstimator(lio::InitializationMode initialization);
-  void Collect();
-  void Warn(const Status& status);
+  // driver::DriverSink: the scans kept, the messages held for TakeMessages.
+  void OnOutputs(const std::vector<swarm::DroneOutput>& outputs) override;
+  void OnMessages(std::vector<net::SwarmMessage>* messages) override;
 
-  DroneInput input_;
+  driver::DroneInput input_;
   std::unique_ptr<io::BagReader> reader_;
-  std::unique_ptr<swarm::DroneEstimator> estimator_;
+  std::unique_ptr<driver::DroneDriver> driver_;
   io::BagRecord next_;
   bool has_next_ = false;
-  bool fuse_ = true;
-  int drone_id_ = 0;
   int64_t restart_ns_ = -1;  // pending restart: the log stamp (-1: none)
   std::vector<int64_t> skip_scan_stamps_ns_;  // sorted
   int64_t skipped_scans_ = 0;
   std::vector<ScanRecord> scans_;
-  std::vector<swarm::DroneOutput> outputs_;  // scratch
+  std::vector<net::SwarmMessage> outbox_;  // produced, not taken yet
   std::vector<swarm::IdentificationEvent> identifications_;
   std::vector<PoseStamped> ground_truth_;
-  DroneWarnings warnings_;
 };
 
 }  // namespace swarmlio::replay

@@ -29,7 +29,7 @@
 #include "swarmlio/net/packet_codec.h"
 #include "swarmlio/net/simulated_network.h"
 #include "swarmlio/replay/drone_runner.h"
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 namespace swarmlio::replay {
 
@@ -78,7 +78,7 @@ struct DroneTraffic {
 class SwarmReplay {
  public:
   /// Opens every drone's bag (all of them: every error is reported, joined).
-  static Status Create(const SwarmManifest& manifest, std::unique_ptr<SwarmReplay>* replay);
+  static Status Create(const driver::SwarmManifest& manifest, std::unique_ptr<SwarmReplay>* replay);
 
   /// Runs to the end of all logs (or max_duration_s). On a read error the
   /// other drones still run to the end; the first error is returned and the
@@ -91,12 +91,12 @@ class SwarmReplay {
 
   int num_drones() const { return static_cast<int>(runners_.size()); }
   const DroneRunner& drone(int i) const { return *runners_[i]; }
-  const SwarmManifest& manifest() const { return manifest_; }
+  const driver::SwarmManifest& manifest() const { return manifest_; }
 
  private:
   SwarmReplay() = default;
 
-  SwarmManifest manifest_;
+  driver::SwarmManifest manifest_;
   std::vector<std::unique_ptr<DroneRunner>> runners_;
   Status SetUpNetwork(const ReplayOptions& options);
   Status OpenRecordedPackets(const ReplayOptions& options);

@@ -17,8 +17,9 @@
 //   6. the broadcaster queues the scan's messages; the output is returned.
 // Received messages go to the inbox, which hands each to its owner at once.
 //
-// Inputs: IMU samples, LiDAR scans (own clock), received messages (their
-// arrival time in the own clock). Outputs: PopOutputs, PopMessages. No I/O,
+// Inputs: Add(SensorRecord): IMU samples, LiDAR scans (own clock), received
+// messages (their arrival time in the own clock). Outputs: PopOutputs,
+// PopMessages. Drivers run it through driver::DroneDriver. No I/O,
 // no clock reads, no threads inside. docs/swarm.md has the math and policies.
 #pragma once
 
@@ -36,6 +37,7 @@
 #include "swarmlio/net/message_channel.h"
 #include "swarmlio/net/messages.h"
 #include "swarmlio/sensors/lidar_options.h"
+#include "swarmlio/swarm/sensor_record.h"
 #include "swarmlio/swarm/swarm_options.h"
 #include "swarmlio/teammate/teammate_detector.h"
 
@@ -124,6 +126,12 @@ class DroneEstimator {
                        std::unique_ptr<DroneEstimator>* estimator);
   ~DroneEstimator();
 
+  /// One input: an IMU sample, a scan, or a received message. Processes
+  /// every scan the IMU now covers (PopOutputs). A data problem the
+  /// estimator skipped (a NaN sample, an out-of-order scan) is returned; the
+  /// estimator stays usable.
+  Status Add(const SensorRecord& record);
+  /// The three kinds of Add.
   Status AddImu(const ImuSample& sample);
   Status AddScan(const LidarScan& scan);
   /// A message from the network (arrival time in this drone's clock). Bad

@@ -1,4 +1,4 @@
-#include "swarmlio/replay/manifest.h"
+#include "swarmlio/driver/manifest.h"
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/config/sensor_preset.h"
 
-namespace swarmlio::replay {
+namespace swarmlio::driver {
 namespace {
 
 using config::FieldSpec;
@@ -19,7 +19,7 @@ struct DroneEntry {
   std::string name;
   std::string bag;
   std::string ground_truth;
-  GroundTruthFrame ground_truth_frame = GroundTruthFrame::kAuto;
+  eval::GroundTruthFrame ground_truth_frame = eval::GroundTruthFrame::kAuto;
   std::string sensor_preset;
   LidarOptions lidar;
   ImuOptions imu;
@@ -225,4 +225,4 @@ Status ManifestFromBags(const std::vector<std::string>& bags, const std::string&
   return Status::Ok();
 }
 
-}  // namespace swarmlio::replay
+}  // namespace swarmlio::driver

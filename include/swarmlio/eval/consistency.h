@@ -21,21 +21,44 @@
 // without translation), as OpenVINS' ov_eval aligns the ground truth to the
 // estimate before its NEES (ResultTrajectory::calculate_nees). Both are
 // reported; docs/results.md says which band uses which.
+//
+// The estimate is an eval::Trajectory of the updated scans' poses with the
+// covariance of each position; the ground truth an eval::Trajectory. Both are
+// compared at the estimate's stamps in integer nanoseconds (the stamps
+// round-trip exactly through the trajectories' seconds for stamps below
+// 2e6 s; above, to within 1 us), the ground truth interpolated from
+// its quaternions (linear in position, slerp in rotation).
 #pragma once
 
+#include <Eigen/Core>
+#include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
-#include "swarmlio/replay/drone_runner.h"
-#include "swarmlio/replay/manifest.h"
-#include "swarmlio/sensors/measurements.h"
+#include "swarmlio/eval/trajectory.h"
 
-namespace swarmlio::replay {
+namespace swarmlio::eval {
+
+/// Frame of a drone's ground truth (manifest key `ground_truth_frame`).
+///   kAuto:  G when the ground truth at the estimate's first stamp matches the
+///           estimate's first pose (within tolerance), else another frame
+///   kG:     the estimator's G (the IMU frame at the static start), declared
+///   kOther: another frame (mocap, simulator world), declared
+enum class GroundTruthFrame { kAuto, kG, kOther };
+
+/// An estimate with the covariance of each position p_b_in_G [m^2], one per
+/// pose (a filter's or smoother's output; the updated scans only).
+struct CovariantTrajectory {
+  Trajectory poses;
+  std::vector<Eigen::Matrix3d> position_covariances;
+};
 
 struct ConsistencyStats {
-  int num_poses = 0;                // scans with ground truth
-  double position_rmse_m = 0.0;     // no alignment
+  int num_poses = 0;             // scans with ground truth
+  double position_rmse_m = 0.0;  // no alignment
   double position_max_m = 0.0;
   double mean_position_nees = 0.0;  // in G, no alignment; expected 3
   /// After rotating the ground truth about the first pose onto the estimate
@@ -45,7 +68,7 @@ struct ConsistencyStats {
   double mean_position_nees_aligned = 0.0;
   double gauge_rotation_deg = 0.0;  // the rotation of that alignment
   double expected_position_nees = 3.0;
-  double rotation_rmse_deg = 0.0;   // |Log(R_true^T R_est)|
+  double rotation_rmse_deg = 0.0;  // |Log(R_true^T R_est)|
 };
 
 /// Whether a drone's ground truth is in the estimator's frame G. G is the
@@ -58,42 +81,54 @@ struct FrameCheckOptions {
 };
 
 struct FrameCheck {
-  bool compared = false;       // a ground-truth pose was found at an estimate stamp
-  int64_t stamp_ns = 0;        // the first estimate stamp with ground truth
+  bool compared = false;             // a ground-truth pose was found at an estimate stamp
+  int64_t stamp_ns = 0;              // the first estimate stamp with ground truth
   double position_offset_m = 0.0;    // |p_true - p_est| there
   double rotation_offset_deg = 0.0;  // |Log(R_true^T R_est)| there
-  bool declared = false;       // the manifest said G or other (no detection)
-  bool same_frame = false;     // frames known to agree: NEES and unaligned errors are meaningful
+  bool declared = false;             // the manifest said G or other (no detection)
+  bool same_frame = false;  // frames known to agree: NEES and unaligned errors are meaningful
   /// One line, e.g. "ground truth in G (first pose within 0.004 m, 0.1 deg)" or
   /// "ground truth in another frame: aligned by first pose and SE(3) (first
   /// pose 3.2 m, 88.5 deg from the estimate's)".
   std::string Summary() const;
 };
 
-/// Compares the ground truth with the estimate at the first updated scan that
-/// the ground truth covers; `declared` (manifest ground_truth_frame) decides
+/// Compares the ground truth with the estimate at the first pose that the
+/// ground truth covers; `declared` (manifest ground_truth_frame) decides
 /// when not kAuto. FailedPrecondition when no scan overlaps the ground truth.
-Status CheckGroundTruthFrame(const std::vector<ScanRecord>& scans,
-                             const std::vector<PoseStamped>& gt, GroundTruthFrame declared,
-                             const FrameCheckOptions& options, FrameCheck* check);
+Status CheckGroundTruthFrame(const Trajectory& estimate,
+                             const Trajectory& gt,
+                             GroundTruthFrame declared,
+                             const FrameCheckOptions& options,
+                             FrameCheck* check);
 
 /// The ground truth moved into G by its first pose: every pose is premultiplied
 /// by T_G_W = T_est(t0) T_true(t0)^-1, t0 = check.stamp_ns (needs
 /// check.compared). The estimate's drift since t0 stays in the errors.
-Status AlignGroundTruthByFirstPose(const std::vector<ScanRecord>& scans,
-                                   const std::vector<PoseStamped>& gt, const FrameCheck& check,
-                                   double max_gt_gap_s, std::vector<PoseStamped>* aligned);
+Status AlignGroundTruthByFirstPose(const Trajectory& estimate,
+                                   const Trajectory& gt,
+                                   const FrameCheck& check,
+                                   double max_gt_gap_s,
+                                   Trajectory* aligned);
 
-/// Ground-truth pose at `stamp_ns` interpolated from `gt` (sorted by stamp).
-/// False when `stamp_ns` is outside `gt` or the bracketing poses are more
-/// than max_gap_ns apart.
-bool InterpolatePose(const std::vector<PoseStamped>& gt, int64_t stamp_ns, int64_t max_gap_ns,
-                     PoseStamped* pose);
-
-/// Statistics over the updated scans of `scans` with ground truth.
-/// FailedPrecondition when no scan overlaps the ground truth.
-Status EvaluateConsistency(const std::vector<ScanRecord>& scans,
-                           const std::vector<PoseStamped>& gt, double max_gt_gap_s,
+/// Statistics over the poses of `estimate` with ground truth.
+/// FailedPrecondition when no pose overlaps the ground truth.
+Status EvaluateConsistency(const CovariantTrajectory& estimate,
+                           const Trajectory& gt,
+                           double max_gt_gap_s,
                            ConsistencyStats* stats);
 
-}  // namespace swarmlio::replay
+}  // namespace swarmlio::eval
+
+namespace swarmlio::config {
+
+template <>
+struct EnumTraits<eval::GroundTruthFrame> {
+  static constexpr std::array<std::pair<eval::GroundTruthFrame, const char*>, 3> kNames{{
+      {eval::GroundTruthFrame::kAuto, "auto"},
+      {eval::GroundTruthFrame::kG, "G"},
+      {eval::GroundTruthFrame::kOther, "other"},
+  }};
+};
+
+}  // namespace swarmlio::config

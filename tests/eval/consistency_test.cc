@@ -1,6 +1,8 @@
 // Ground truth in the estimator's G or in another frame (mocap, simulator
 // world): CheckGroundTruthFrame decides, AlignGroundTruthByFirstPose moves it
-// into G, and the manifest key ground_truth_frame overrides the detection.
+// into G, and a declared frame overrides the detection.
+#include "swarmlio/eval/consistency.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -10,15 +12,27 @@
 #include <vector>
 
 #include "swarmlio/math/so3.h"
-#include "swarmlio/replay/consistency.h"
-#include "swarmlio/replay/manifest.h"
 
-namespace swarmlio::replay {
+namespace swarmlio::eval {
 namespace {
+
+// One estimated pose (an updated scan's) with its position covariance.
+void AddPose(int64_t stamp_ns,
+             const Eigen::Quaterniond& q_G_b,
+             const Eigen::Vector3d& p_b_in_G,
+             const Eigen::Matrix3d& P_pp,
+             CovariantTrajectory* estimate) {
+  Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+  T_G_b.linear() = q_G_b.normalized().toRotationMatrix();
+  T_G_b.translation() = p_b_in_G;
+  estimate->poses.stamps_s.push_back(StampSeconds(stamp_ns));
+  estimate->poses.T_G_b.push_back(T_G_b);
+  estimate->position_covariances.push_back(P_pp);
+}
 
 // An estimate along a curve in G (1 cm off the truth), and its ground truth
 // in G, 20 Hz, 5 s.
-void MakeRun(std::vector<ScanRecord>* scans, std::vector<PoseStamped>* truth) {
+void MakeRun(CovariantTrajectory* scans, std::vector<PoseStamped>* truth) {
   for (int k = 0; k < 100; ++k) {
     const double t = 0.05 * k;
     PoseStamped p;
@@ -26,13 +40,8 @@ void MakeRun(std::vector<ScanRecord>* scans, std::vector<PoseStamped>* truth) {
     p.p_b_in_G = Eigen::Vector3d(std::sin(t), 0.5 * t, 0.1 * t * t);
     p.q_G_b = so3::ExpQuaternion(Eigen::Vector3d(0.0, 0.02 * t, 0.3 * t));
     truth->push_back(p);
-    ScanRecord r;
-    r.stamp_ns = p.stamp_ns;
-    r.updated = true;
-    r.state.p_b_in_G = p.p_b_in_G + Eigen::Vector3d(0.01, 0.0, 0.0);
-    r.state.q_G_b = p.q_G_b;
-    r.pose_covariance = 1e-4 * Eigen::Matrix<double, 6, 6>::Identity();
-    scans->push_back(r);
+    AddPose(p.stamp_ns, p.q_G_b, p.p_b_in_G + Eigen::Vector3d(0.01, 0.0, 0.0),
+            1e-4 * Eigen::Matrix3d::Identity(), scans);
   }
 }
 
@@ -48,13 +57,13 @@ std::vector<PoseStamped> InWorld(const std::vector<PoseStamped>& truth) {
 }
 
 TEST(FrameCheck, GroundTruthInGIsDetected) {
-  std::vector<ScanRecord> scans;
+  CovariantTrajectory scans;
   std::vector<PoseStamped> truth;
   MakeRun(&scans, &truth);
   FrameCheck check;
-  ASSERT_TRUE(
-      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
-          .ok());
+  ASSERT_TRUE(CheckGroundTruthFrame(scans.poses, TrajectoryFromPoses(truth),
+                                    GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
+                  .ok());
   EXPECT_TRUE(check.compared);
   EXPECT_TRUE(check.same_frame);
   EXPECT_FALSE(check.declared);
@@ -63,14 +72,14 @@ TEST(FrameCheck, GroundTruthInGIsDetected) {
 }
 
 TEST(FrameCheck, ForeignFrameIsDetectedAndAlignedByTheFirstPose) {
-  std::vector<ScanRecord> scans;
+  CovariantTrajectory scans;
   std::vector<PoseStamped> truth;
   MakeRun(&scans, &truth);
   const std::vector<PoseStamped> world = InWorld(truth);
   FrameCheck check;
-  ASSERT_TRUE(
-      CheckGroundTruthFrame(scans, world, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
-          .ok());
+  ASSERT_TRUE(CheckGroundTruthFrame(scans.poses, TrajectoryFromPoses(world),
+                                    GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
+                  .ok());
   EXPECT_FALSE(check.same_frame);
   EXPECT_GT(check.position_offset_m, 1.0);
   EXPECT_NE(check.Summary().find("ground truth in another frame: aligned by first pose and SE(3)"),
@@ -80,21 +89,24 @@ TEST(FrameCheck, ForeignFrameIsDetectedAndAlignedByTheFirstPose) {
   // Unaligned, the NEES of a foreign frame is huge; aligned by the first pose
   // the position errors are the estimate's own (1 cm here).
   ConsistencyStats raw, aligned_stats;
-  ASSERT_TRUE(EvaluateConsistency(scans, world, 0.06, &raw).ok());
+  ASSERT_TRUE(EvaluateConsistency(scans, TrajectoryFromPoses(world), 0.06, &raw).ok());
   EXPECT_GT(raw.mean_position_nees, 1e4);
-  std::vector<PoseStamped> aligned;
-  ASSERT_TRUE(AlignGroundTruthByFirstPose(scans, world, check, 0.06, &aligned).ok());
+  Trajectory aligned;
+  ASSERT_TRUE(
+      AlignGroundTruthByFirstPose(scans.poses, TrajectoryFromPoses(world), check, 0.06, &aligned)
+          .ok());
   ASSERT_TRUE(EvaluateConsistency(scans, aligned, 0.06, &aligned_stats).ok());
   EXPECT_LT(aligned_stats.position_rmse_m, 0.012);
 
   // Declared: the manifest wins over the detection.
-  ASSERT_TRUE(
-      CheckGroundTruthFrame(scans, world, GroundTruthFrame::kG, FrameCheckOptions(), &check).ok());
+  ASSERT_TRUE(CheckGroundTruthFrame(scans.poses, TrajectoryFromPoses(world), GroundTruthFrame::kG,
+                                    FrameCheckOptions(), &check)
+                  .ok());
   EXPECT_TRUE(check.same_frame);
   EXPECT_TRUE(check.declared);
-  ASSERT_TRUE(
-      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kOther, FrameCheckOptions(), &check)
-          .ok());
+  ASSERT_TRUE(CheckGroundTruthFrame(scans.poses, TrajectoryFromPoses(truth),
+                                    GroundTruthFrame::kOther, FrameCheckOptions(), &check)
+                  .ok());
   EXPECT_FALSE(check.same_frame);
 }
 
@@ -110,7 +122,7 @@ TEST(GaugeAlignedNees, RemovesAFrameRotationAboutTheStartAndNothingElse) {
   const Eigen::Vector3d dtheta(0.002, -0.003, 0.0055);  // |dtheta| = 0.0066 rad = 0.38 deg
   const Eigen::Quaterniond q_map_G = so3::ExpQuaternion(dtheta);
   const double sigma_m = 0.004;
-  auto make = [&](double covariance_scale, std::vector<ScanRecord>* scans,
+  auto make = [&](double covariance_scale, CovariantTrajectory* scans,
                   std::vector<PoseStamped>* truth) {
     std::mt19937 rng(7);
     std::normal_distribution<double> normal(0.0, sigma_m);
@@ -121,23 +133,17 @@ TEST(GaugeAlignedNees, RemovesAFrameRotationAboutTheStartAndNothingElse) {
       p.p_b_in_G = Eigen::Vector3d(1.0 * t, 1.5 * std::sin(0.3 * t), 1.0 + 0.5 * std::cos(0.2 * t));
       if (k == 0) p.p_b_in_G.setZero();
       truth->push_back(p);
-      ScanRecord r;
-      r.stamp_ns = p.stamp_ns;
-      r.updated = true;
       const Eigen::Vector3d noise =
-          k == 0 ? Eigen::Vector3d::Zero()
-                 : Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-      r.state.p_b_in_G = q_map_G * p.p_b_in_G + noise;
-      r.pose_covariance = covariance_scale * sigma_m * sigma_m *
-                          Eigen::Matrix<double, 6, 6>::Identity();
-      scans->push_back(r);
+          k == 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      AddPose(p.stamp_ns, Eigen::Quaterniond::Identity(), q_map_G * p.p_b_in_G + noise,
+              covariance_scale * sigma_m * sigma_m * Eigen::Matrix3d::Identity(), scans);
     }
   };
-  std::vector<ScanRecord> scans;
+  CovariantTrajectory scans;
   std::vector<PoseStamped> truth;
   make(1.0, &scans, &truth);
   ConsistencyStats s;
-  ASSERT_TRUE(EvaluateConsistency(scans, truth, 0.2, &s).ok());
+  ASSERT_TRUE(EvaluateConsistency(scans, TrajectoryFromPoses(truth), 0.2, &s).ok());
   EXPECT_GT(s.mean_position_nees, 100.0);
   // 600 samples of a chi^2(3): the mean has a std of 0.1; the fit takes 3 dof.
   EXPECT_GT(s.mean_position_nees_aligned, 2.6);
@@ -145,71 +151,39 @@ TEST(GaugeAlignedNees, RemovesAFrameRotationAboutTheStartAndNothingElse) {
   EXPECT_NEAR(s.gauge_rotation_deg, dtheta.norm() * 180.0 / M_PI, 0.01);
 
   // Overconfident by 4x: the aligned NEES shows it.
-  std::vector<ScanRecord> over;
+  CovariantTrajectory over;
   std::vector<PoseStamped> truth_over;
   make(0.25, &over, &truth_over);
-  ASSERT_TRUE(EvaluateConsistency(over, truth_over, 0.2, &s).ok());
+  ASSERT_TRUE(EvaluateConsistency(over, TrajectoryFromPoses(truth_over), 0.2, &s).ok());
   EXPECT_GT(s.mean_position_nees_aligned, 10.0);
 }
 
 TEST(GaugeAlignedNees, AHoverFixesNoRotation) {
-  std::vector<ScanRecord> scans;
+  CovariantTrajectory scans;
   std::vector<PoseStamped> truth;
   for (int k = 0; k < 50; ++k) {
     PoseStamped p;
     p.stamp_ns = 1'000'000'000LL + 100'000'000LL * k;
     p.p_b_in_G = Eigen::Vector3d(0.001 * k, 0.0, 0.0);  // 5 cm along one line
     truth.push_back(p);
-    ScanRecord r;
-    r.stamp_ns = p.stamp_ns;
-    r.updated = true;
-    r.state.p_b_in_G = p.p_b_in_G;
-    r.pose_covariance = 1e-4 * Eigen::Matrix<double, 6, 6>::Identity();
-    scans.push_back(r);
+    AddPose(p.stamp_ns, p.q_G_b, p.p_b_in_G, 1e-4 * Eigen::Matrix3d::Identity(), &scans);
   }
   ConsistencyStats s;
-  ASSERT_TRUE(EvaluateConsistency(scans, truth, 0.2, &s).ok());
+  ASSERT_TRUE(EvaluateConsistency(scans, TrajectoryFromPoses(truth), 0.2, &s).ok());
   EXPECT_TRUE(std::isnan(s.mean_position_nees_aligned));
 }
 
 TEST(FrameCheck, NoOverlapIsAnError) {
-  std::vector<ScanRecord> scans;
+  CovariantTrajectory scans;
   std::vector<PoseStamped> truth;
   MakeRun(&scans, &truth);
   for (PoseStamped& p : truth) p.stamp_ns += 100'000'000'000LL;
   FrameCheck check;
-  EXPECT_EQ(
-      CheckGroundTruthFrame(scans, truth, GroundTruthFrame::kAuto, FrameCheckOptions(), &check)
-          .code(),
-      Status::Code::kFailedPrecondition);
-}
-
-TEST(FrameCheck, ManifestKeyGroundTruthFrame) {
-  SwarmManifest manifest;
-  const Status status = ParseManifest(
-      "name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: G}\n"
-      "  - {name: b, bag: b.bag, ground_truth_frame: other}\n  - {name: c, bag: c.bag}\n",
-      "/tmp/m.yaml", &manifest);
-  ASSERT_TRUE(status.ok()) << status.message();
-  EXPECT_EQ(manifest.drones[0].ground_truth_frame, GroundTruthFrame::kG);
-  EXPECT_EQ(manifest.drones[1].ground_truth_frame, GroundTruthFrame::kOther);
-  EXPECT_EQ(manifest.drones[2].ground_truth_frame, GroundTruthFrame::kAuto);
-  EXPECT_FALSE(ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, ground_truth_frame: W}\n",
-                             "/tmp/m.yaml", &manifest)
-                   .ok());
-}
-
-TEST(FrameCheck, ManifestMarksSpinningLidars) {
-  SwarmManifest manifest;
-  const std::string preset = std::string(SWARMLIO_SOURCE_DIR) + "/configs/spinning_32.yaml";
-  ASSERT_TRUE(ManifestFromBags({"a.bag"}, preset, {}, &manifest).ok());
-  EXPECT_TRUE(manifest.drones[0].bag.spinning_lidar);
-  ASSERT_TRUE(ParseManifest("name: x\ndrones:\n  - {name: a, bag: a.bag, sensor_preset: " + preset +
-                                ", bag_topics: {spinning_lidar: false}}\n",
-                            "/tmp/m.yaml", &manifest)
-                  .ok());
-  EXPECT_FALSE(manifest.drones[0].bag.spinning_lidar);
+  EXPECT_EQ(CheckGroundTruthFrame(scans.poses, TrajectoryFromPoses(truth), GroundTruthFrame::kAuto,
+                                  FrameCheckOptions(), &check)
+                .code(),
+            Status::Code::kFailedPrecondition);
 }
 
 }  // namespace
-}  // namespace swarmlio::replay
+}  // namespace swarmlio::eval

@@ -24,12 +24,11 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <array>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "swarmlio/common/status.h"
+#include "swarmlio/eval/consistency.h"
 #include "swarmlio/io/bag_options.h"
 #include "swarmlio/lio/odometry_options.h"
 #include "swarmlio/sensors/imu_options.h"
@@ -37,14 +36,7 @@
 #include "swarmlio/swarm/swarm_options.h"
 #include "swarmlio/teammate/teammate_detector_options.h"
 
-namespace swarmlio::replay {
-
-/// Frame of a drone's ground truth (manifest key `ground_truth_frame`).
-///   kAuto:  G when the ground truth at the estimate's first stamp matches the
-///           estimate's first pose (within tolerance), else another frame
-///   kG:     the estimator's G (the IMU frame at the static start), declared
-///   kOther: another frame (mocap, simulator world), declared
-enum class GroundTruthFrame { kAuto, kG, kOther };
+namespace swarmlio::driver {
 
 /// How a drone's clock relates to the true time of a simulated run (YAML
 /// `true_clock:` of a drone entry; the simulator writes it): the drone stamps
@@ -75,7 +67,7 @@ struct DroneInput {
   std::string name;
   std::string bag_path;           // resolved (relative to the manifest folder)
   std::string ground_truth_path;  // resolved TUM file, "" = none
-  GroundTruthFrame ground_truth_frame = GroundTruthFrame::kAuto;
+  eval::GroundTruthFrame ground_truth_frame = eval::GroundTruthFrame::kAuto;
   LidarOptions lidar;
   ImuOptions imu;
   io::BagReaderOptions bag;
@@ -133,17 +125,4 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
 Status ManifestFromBags(const std::vector<std::string>& bags, const std::string& sensor_preset,
                         const std::vector<std::string>& names, SwarmManifest* manifest);
 
-}  // namespace swarmlio::replay
-
-namespace swarmlio::config {
-
-template <>
-struct EnumTraits<replay::GroundTruthFrame> {
-  static constexpr std::array<std::pair<replay::GroundTruthFrame, const char*>, 3> kNames{{
-      {replay::GroundTruthFrame::kAuto, "auto"},
-      {replay::GroundTruthFrame::kG, "G"},
-      {replay::GroundTruthFrame::kOther, "other"},
-  }};
-};
-
-}  // namespace swarmlio::config
+}  // namespace swarmlio::driver
