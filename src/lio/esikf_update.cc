@@ -17,7 +17,7 @@
 #include "factors/prior_factor.h"
 #include "swarmlio/math/so3.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -620,4 +620,4 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
   return result;
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -27,7 +27,7 @@ class DetectorInput {
   /// The detector's points of `raw` (t_k: its end, `poses`: propagated over
   /// it), given the predicted state `x` and the trackers of the last
   /// detection (made at last_detection_s).
-  Status Make(const LidarScan& raw, int64_t t_k, const std::vector<ImuPose>& poses,
+  Status Make(const LidarScan& raw, int64_t t_k, const std::vector<lio::ImuPose>& poses,
               const SwarmState& x, const teammate::ScanResult& last_detection,
               double last_detection_s, std::vector<teammate::ScanPoint>* points);
 
@@ -42,7 +42,7 @@ class DetectorInput {
   SwarmOptions swarm_;
   LidarOptions lidar_;
   LidarScan selected_;
-  std::vector<UndistortedPoint> undistorted_;
+  std::vector<lio::UndistortedPoint> undistorted_;
 };
 
 }  // namespace swarmlio::swarm::internal
