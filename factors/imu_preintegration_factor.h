@@ -5,7 +5,7 @@
 //
 // Parameter blocks (ambient): ego_k, ego_k+1 (19 each) = [q_G_b (x y z w) | p |
 // v | b_g | b_a | g]. Constants (PreintegratedImu, built by
-// swarmlio::ImuPreintegration from the samples in [t_k, t_k+1]): T = t_k+1 - t_k,
+// swarmlio::lio::ImuPreintegration from the samples in [t_k, t_k+1]): T = t_k+1 - t_k,
 // DeltaR, Deltav, Deltap (in b_k, gravity excluded) at the linearization biases
 // (bg_bar, ba_bar), their bias Jacobians, and the covariance Sigma (18x18).
 //

@@ -127,8 +127,8 @@ int64_t TrueClock::ToTrue(int64_t drone_ns) const {
 lio::OdometryOptions DefaultOdometryOptions(const LidarOptions& lidar, const ImuOptions& imu) {
   lio::OdometryOptions odometry = lio::OdometryOptionsFor(lidar);
   odometry.imu_init.acceleration_unit = imu.acceleration_unit == AccelerationUnit::kStandardGravity
-                                            ? AccelerationUnitSetting::kStandardGravity
-                                            : AccelerationUnitSetting::kMetersPerSecondSquared;
+                                            ? lio::AccelerationUnitSetting::kStandardGravity
+                                            : lio::AccelerationUnitSetting::kMetersPerSecondSquared;
   odometry.imu_init.nominal_gravity_m_s2 = imu.gravity_m_s2;
   return odometry;
 }

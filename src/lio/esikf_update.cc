@@ -15,9 +15,10 @@
 #include "factors/ego_state_manifold.h"
 #include "factors/global_extrinsic_manifold.h"
 #include "factors/prior_factor.h"
+#include "factors/term_linearizer.h"
 #include "swarmlio/math/so3.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -102,9 +103,9 @@ Eigen::MatrixXd Gather(const Eigen::MatrixXd& P, const std::vector<int>& rows,
 
 namespace {
 
-// J^T J of one residual block at the parameter values it points to: the
-// cost's ambient Jacobians times each block's PlusJacobian, placed at the
-// block's columns of the layout.
+// J^T J of one residual block at the parameter values it points to (tangent
+// Jacobians, factors/term_linearizer.h), placed at the block's columns of the
+// layout.
 bool AddTermInformation(const ResidualTerm& term, const std::vector<double*>& pointers,
                         const ErrorStateLayout& layout, const ceres::Manifold& ego_manifold,
                         const ceres::Manifold& teammate_manifold, Eigen::MatrixXd* information) {
@@ -123,23 +124,17 @@ bool AddTermInformation(const ResidualTerm& term, const std::vector<double*>& po
     manifolds[b] = ego ? &ego_manifold : &teammate_manifold;
     tangent[b] = manifolds[b]->TangentSize();
   }
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  std::vector<RowMajor> ambient(nb);
-  std::vector<double*> jacobians(nb);
-  for (size_t b = 0; b < nb; ++b) {
-    ambient[b].resize(m, manifolds[b]->AmbientSize());
-    jacobians[b] = ambient[b].data();
+  Eigen::VectorXd residuals;
+  std::vector<Eigen::MatrixXd> tangent_jacobians;
+  if (!LinearizeTerm(*term.cost, params.data(), manifolds, &residuals, &tangent_jacobians).ok()) {
+    return false;
   }
-  Eigen::VectorXd residuals(m);
-  if (!term.cost->Evaluate(params.data(), residuals.data(), jacobians.data())) return false;
   int cols = 0;
   for (size_t b = 0; b < nb; ++b) cols += tangent[b];
   Eigen::MatrixXd J(m, cols);
   int c = 0;
   for (size_t b = 0; b < nb; ++b) {
-    RowMajor plus(manifolds[b]->AmbientSize(), tangent[b]);
-    if (!manifolds[b]->PlusJacobian(params[b], plus.data())) return false;
-    J.middleCols(c, tangent[b]) = ambient[b] * plus;
+    J.middleCols(c, tangent[b]) = tangent_jacobians[b];
     c += tangent[b];
   }
   const Eigen::MatrixXd JtJ = J.transpose() * J;
@@ -620,4 +615,4 @@ EsikfUpdateResult EsikfUpdate::RunAll(const SwarmState& x_hat,
   return result;
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -8,7 +8,7 @@
 
 #include "swarmlio/lio/esikf_update.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 // Undamped Gauss-Newton with Ceres's trust-region minimizer: one step per
 // Solve, Levenberg-Marquardt with a radius of 1e16 so that the damping
@@ -63,4 +63,4 @@ bool PlaneMeasurementModel::AddInformation(const SwarmState& x,
   return true;
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -7,7 +7,7 @@
 
 #include "swarmlio/math/so3.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using L = ErrorStateLayout;
@@ -449,4 +449,4 @@ Status ImuInitializer::InitializeInFlight(const InFlightCoarseSigmas& coarse,
   return Status::Ok();
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

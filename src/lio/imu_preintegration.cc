@@ -6,7 +6,7 @@
 
 #include "swarmlio/common/check.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using L = ErrorStateLayout;
@@ -224,8 +224,8 @@ Status ImuPreintegration::IntegrateTo(int64_t stamp_ns, const ImuSample* next_sa
 ImuInput ImuPreintegration::MidpointInput(const ImuInput& next,
                                           int64_t next_stamp_ns,
                                           int64_t end_ns) const {
-  return swarmlio::MidpointInput(last_input_, last_sample_stamp_ns_, next, next_stamp_ns, stamp_ns_,
+  return lio::MidpointInput(last_input_, last_sample_stamp_ns_, next, next_stamp_ns, stamp_ns_,
                                  end_ns);
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

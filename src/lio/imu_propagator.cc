@@ -6,7 +6,7 @@
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/math/so3.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using L = ErrorStateLayout;
@@ -256,7 +256,7 @@ ImuInput MidpointInput(const ImuInput& last, int64_t last_stamp_ns, const ImuInp
 ImuInput ImuPropagator::MidpointInput(const ImuInput& next,
                                       int64_t next_stamp_ns,
                                       int64_t end_ns) const {
-  return swarmlio::MidpointInput(last_input_, last_sample_stamp_ns_, next, next_stamp_ns, stamp_ns_,
+  return lio::MidpointInput(last_input_, last_sample_stamp_ns_, next, next_stamp_ns, stamp_ns_,
                                  end_ns);
 }
 
@@ -325,4 +325,4 @@ void ImuPropagator::PropagateCovariance(const EgoMatrix& F, const EgoNoiseMatrix
   P_.leftCols(kEgo) = ego_rows.transpose();
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

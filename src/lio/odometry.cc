@@ -5,7 +5,6 @@
 #include <cmath>
 #include <utility>
 
-#include "swarmlio/lio/esikf_update.h"
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/in_flight_alignment.h"
@@ -14,11 +13,11 @@
 #include "swarmlio/lio/scan_association.h"
 #include "swarmlio/lio/undistortion.h"
 #include "odometry_impl.h"
-#include "window_smoother.h"
+#include "src/lio/filter_back_end.h"
+#include "src/window/window_back_end.h"
 
 namespace swarmlio::lio {
 namespace {
-
 
 using Clock = std::chrono::steady_clock;
 
@@ -32,12 +31,6 @@ int64_t ScanEndNs(const LidarScan& scan) {
     if (std::isfinite(p.offset_time_s)) last_s = std::max(last_s, p.offset_time_s);
   }
   return scan.stamp_ns + static_cast<int64_t>(std::llround(last_s * 1e9));
-}
-
-bool IsFinite(const SwarmState& x, const Eigen::MatrixXd& P) {
-  return x.ego.q_G_b.coeffs().allFinite() && x.ego.p_b_in_G.allFinite() &&
-         x.ego.v_b_in_G.allFinite() && x.ego.gyro_bias.allFinite() &&
-         x.ego.accel_bias.allFinite() && x.ego.g_in_G.allFinite() && P.allFinite();
 }
 
 }  // namespace
@@ -55,12 +48,17 @@ Status Odometry::Create(const OdometryOptions& options, const LidarOptions& lida
   SWARMLIO_RETURN_IF_ERROR(ImuPropagator::Create(options.propagation, &out->impl_->propagator));
   out->impl_->preprocess = std::make_unique<Preprocess>(
       options.preprocess, lidar.QuaternionImuLidar().toRotationMatrix(), lidar.p_lidar_in_imu_m);
-  if (options.estimator == EstimatorKind::kWindow) {
-    SWARMLIO_RETURN_IF_ERROR(internal::WindowSmoother::Create(
-        options.window, options.propagation, options.association, options.update,
-        &out->impl_->map, &out->impl_->window));
-  }
+  SWARMLIO_RETURN_IF_ERROR(out->CreateBackEnd());
   *odometry = std::move(out);
+  return Status::Ok();
+}
+
+Status Odometry::CreateBackEnd() {
+  Impl& im = *impl_;
+  if (options_.estimator == EstimatorKind::kWindow) {
+    return internal::WindowBackEnd::Create(options_, &im.map, im.propagator.get(), &im.back_end);
+  }
+  im.back_end = std::make_unique<internal::FilterBackEnd>(options_, &im.map, im.propagator.get());
   return Status::Ok();
 }
 
@@ -185,54 +183,7 @@ void Odometry::SeedMapFromStaticStart(int64_t window_start_ns) {
 
 void Odometry::FinishLog() {
   if (impl_->seed_pending) SeedMapFromStaticStart(impl_->seed_window_start_ns);
-  if (impl_->window != nullptr) {
-    // The scans still in the window enter the map at their current estimates.
-    std::vector<internal::LeavingScan> scans;
-    impl_->window->TakeScansForMap(&scans);
-    for (const internal::LeavingScan& s : scans) {
-      InsertScan(s.points_in_b, s.state, s.excluded, nullptr,
-                 options_.insert_matched_points ? nullptr : &s.matched);
-    }
-  }
-}
-
-int Odometry::InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const EgoState& x,
-                         const std::vector<ExcludedRegion>& excluded,
-                         std::vector<Eigen::Vector3d>* registered_out,
-                         const std::vector<int>* skip_indices) {
-  const Eigen::Matrix3d R_G_b = x.q_G_b.toRotationMatrix();
-  std::vector<Eigen::Vector3d> registered;
-  std::vector<double> ranges;  // from the body origin: the LiDAR's within its lever arm
-  registered.reserve(points_in_b.size());
-  ranges.reserve(points_in_b.size());
-  if (registered_out != nullptr) registered_out->clear();
-  std::vector<bool> skip;
-  if (skip_indices != nullptr) {
-    skip.assign(points_in_b.size(), false);
-    for (int i : *skip_indices) {
-      if (i >= 0 && static_cast<size_t>(i) < skip.size()) skip[static_cast<size_t>(i)] = true;
-    }
-  }
-  int num_excluded = 0;
-  for (size_t i = 0; i < points_in_b.size(); ++i) {
-    const Eigen::Vector3d& p = points_in_b[i];
-    bool inside = false;
-    for (const ExcludedRegion& region : excluded) {
-      inside |= (p - region.center_in_b).squaredNorm() <= region.radius_m * region.radius_m;
-    }
-    if (inside) {
-      ++num_excluded;
-      continue;
-    }
-    const Eigen::Vector3d q = R_G_b * p + x.p_b_in_G;
-    if (registered_out != nullptr) registered_out->push_back(q);
-    if (!skip.empty() && skip[i]) continue;
-    registered.push_back(q);
-    ranges.push_back(p.norm());
-  }
-  impl_->map.UpdateCenter(x.p_b_in_G);
-  impl_->map.Insert(registered, &ranges);
-  return num_excluded;
+  impl_->back_end->Flush();
 }
 
 Status Odometry::ProcessReadyScans(bool flush, std::vector<ScanOutput>* outputs) {
@@ -343,15 +294,14 @@ bool Odometry::Propagate(ScanContext* scan) {
     return false;
   }
   prop.StartScan();
-  if (im.window != nullptr) {
-    // The window's IMU factor integrates exactly what the propagator consumes.
-    im.window->StartInterval(prop.stamp_ns(), prop.last_sample(),
+  // The back end's IMU interval (the window's factor) gets exactly what the
+  // propagator consumes.
+  im.back_end->StartInterval(prop.stamp_ns(), prop.last_sample(),
                              im.initialization.acceleration_to_m_s2, prop.state().ego);
-  }
   while (!im.imu_queue.empty() && im.imu_queue.front().stamp_ns <= end_ns) {
     const ImuSample sample = im.imu_queue.front();
     im.imu_queue.pop_front();
-    if (im.window != nullptr) im.window->AddImu(sample);
+    im.back_end->AddImu(sample);
     Status status = prop.AddImu(sample);
     if (status.code() == Status::Code::kOutOfRange) {
       // A gap in the IMU stream: hold the state and restart from this sample.
@@ -369,7 +319,7 @@ bool Odometry::Propagate(ScanContext* scan) {
     }
   }
   const ImuSample* next = im.imu_queue.empty() ? nullptr : &im.imu_queue.front();
-  if (im.window != nullptr) im.window->IntegrateTo(end_ns, next);
+  im.back_end->IntegrateTo(end_ns, next);
   if (Status status = prop.PropagateTo(end_ns, next); !status.ok()) {
     // Flushing past the end of the IMU data: hold the state at its last time.
     if (!scan->flush || status.code() != Status::Code::kOutOfRange) {
@@ -384,34 +334,15 @@ void Odometry::Update(const UpdateRequest& request, ScanContext* scan) {
   Impl& im = *impl_;
   // The front end may have changed the teammate blocks.
   if (scan->x.layout() != im.propagator->state().layout()) im.propagator->SetState(scan->x, scan->P);
-  if (im.window != nullptr) {
-    UpdateWithWindow(request, scan);
-  } else {
-    UpdateWithFilter(request, scan);
-  }
+  im.back_end->Update(request, im.undistorted, scan, &counters_);
+  if (scan->out.updated) im.previous_degenerate = scan->out.degenerate;
 }
 
 Status Odometry::Commit(ScanContext* scan, ScanOutput* output) {
   Impl& im = *impl_;
   ScanOutput& out = scan->out;
-  if (im.window == nullptr) {
-    // 5. Map: register with the (posterior) state and insert, except the
-    // points in the excluded regions (teammates). Only updated scans and the
-    // very first one grow the map, so a failed update cannot write a
-    // misregistered scan into it.
-    const Clock::time_point t = Clock::now();
-    if (out.updated || im.map_was_empty) {
-      // Without insert_matched_points, the points the update matched to a map
-      // plane stay out of the map (the map explains them already).
-      const std::vector<int>* matched = options_.insert_matched_points || !out.updated
-                                            ? nullptr
-                                            : &im.associator.matched_point_indices();
-      out.num_excluded_points =
-          InsertScan(im.undistorted, scan->x.ego, scan->excluded,
-                     options_.output_registered_scan ? &out.registered_in_G : nullptr, matched);
-    }
-    out.timings.map_update_s = SecondsSince(t);
-  }
+  // 5. Map (the back end's part: the filter inserts this scan).
+  im.back_end->Commit(im.undistorted, scan);
   out.map_size = im.map.size();
   out.stamp_ns = im.propagator->stamp_ns();
   out.state = scan->x.ego;
@@ -421,144 +352,6 @@ Status Odometry::Commit(ScanContext* scan, ScanOutput* output) {
   ++counters_.scans_processed;
   *output = std::move(out);
   return scan->status;
-}
-
-void Odometry::UpdateWithFilter(const UpdateRequest& request, ScanContext* scan) {
-  Impl& im = *impl_;
-  SwarmState& x = scan->x;
-  Eigen::MatrixXd& P = scan->P;
-  ScanOutput* out = &scan->out;
-  ImuPropagator& prop = *im.propagator;
-  const bool map_ready = !im.map.empty();
-  im.map_was_empty = !map_ready;
-  const bool enough_points = static_cast<int>(im.undistorted.size()) >= options_.min_scan_points;
-  if (!map_ready || !enough_points) return;
-  im.associator.Reset(&im.undistorted);
-  PlaneMeasurementModel planes(
-      [&](const SwarmState& at, std::vector<PlaneCorrespondence>* correspondences) {
-        return im.associator.Associate(at, correspondences);
-      });
-  std::vector<MeasurementModel*> models{&planes};
-  models.insert(models.end(), request.models.begin(), request.models.end());
-  const bool subset = request.select_teammates;
-  const EsikfUpdateResult result =
-      im.update.Run(x, P, models, subset ? &request.estimated_teammates : nullptr,
-                    subset ? &request.considered_teammates : nullptr, prop.stamp_ns());
-  out->timings.association_s = result.association_time_s;
-  out->timings.solve_s = result.solve_time_s;
-  out->timings.covariance_s = result.covariance_time_s;
-  out->iterations = result.iterations;
-  out->converged = result.converged;
-  out->num_correspondences = static_cast<int>(planes.correspondences().size());
-  out->num_measurement_blocks = result.num_residual_blocks;
-  out->min_normal_information = im.associator.stats().MinNormalInformation();
-  out->degenerate = out->min_normal_information < options_.association.degeneracy_threshold;
-  if (result.status.ok() && IsFinite(result.state, result.covariance)) {
-    x = result.state;
-    P = result.covariance;
-    out->updated = true;
-    ++counters_.scans_updated;
-    if (out->degenerate) ++counters_.scans_degenerate;
-    im.previous_degenerate = out->degenerate;
-    prop.SetState(x, P);
-  } else {
-    ++counters_.updates_failed;
-    out->update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
-  }
-}
-
-void Odometry::UpdateWithWindow(const UpdateRequest& request, ScanContext* scan) {
-  Impl& im = *impl_;
-  SwarmState& x = scan->x;
-  Eigen::MatrixXd& P = scan->P;
-  ScanOutput* out = &scan->out;
-  ImuPropagator& prop = *im.propagator;
-  const bool enough_points = static_cast<int>(im.undistorted.size()) >= options_.min_scan_points;
-
-  // The state joins the window; the states beyond K leave it, marginalized.
-  internal::WindowStateInput input;
-  input.stamp_ns = prop.stamp_ns();
-  input.x_pred = x;
-  input.P_pred = P;
-  input.points_in_b = im.undistorted;
-  input.use_planes = enough_points;
-  input.excluded = scan->excluded;
-  input.models = request.models;
-  input.considered_teammates = request.considered_teammates;
-  std::vector<internal::LeavingScan> leaving;
-  std::string model_error;
-  const Status added = im.window->AddState(std::move(input), &leaving, &out->timings.marginalize_s,
-                                           &model_error);
-  if (!model_error.empty()) {
-    out->front_end_error += (out->front_end_error.empty() ? "" : "; ") + model_error;
-  }
-
-  // Map: the scans that left, at their final estimates (only scans that a
-  // solve updated; docs/window.md "Map"). An empty map is built from the
-  // newest scan at its prediction, like the filter's first scan.
-  Clock::time_point t = Clock::now();
-  for (const internal::LeavingScan& l : leaving) {
-    if (l.insert) {
-      InsertScan(l.points_in_b, l.state, l.excluded, nullptr,
-                 options_.insert_matched_points ? nullptr : &l.matched);
-    }
-  }
-  if (im.map.empty()) {
-    out->num_excluded_points = InsertScan(im.undistorted, x.ego, scan->excluded, nullptr);
-    if (added.ok()) im.window->MarkNewestInMap();
-  }
-  out->timings.map_update_s = SecondsSince(t);
-  if (!added.ok()) {
-    ++counters_.updates_failed;
-    out->update_error = added.message();
-    return;
-  }
-
-  TakeWindowSolution(im.window->Solve(), enough_points, scan);
-  if (options_.output_registered_scan) {
-    const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
-    for (const Eigen::Vector3d& p : im.undistorted) {
-      out->registered_in_G.push_back(R_G_b * p + x.ego.p_b_in_G);
-    }
-  }
-}
-
-void Odometry::TakeWindowSolution(const internal::WindowSolveResult& result, bool enough_points,
-                                  ScanContext* scan) {
-  Impl& im = *impl_;
-  ScanOutput* out = &scan->out;
-  SwarmState& x = scan->x;
-  Eigen::MatrixXd& P = scan->P;
-  ImuPropagator& prop = *im.propagator;
-  out->timings.build_s = result.build_s;
-  out->timings.association_s = result.association_s;
-  out->timings.solve_s = result.solve_s;
-  out->timings.covariance_s = result.covariance_s;
-  out->iterations = result.iterations;
-  out->converged = result.converged;
-  out->num_correspondences = result.num_correspondences;
-  out->num_measurement_blocks = result.num_residual_blocks;
-  const bool attempted = result.updated || result.iterations > 0;
-  if (attempted && enough_points) {
-    out->min_normal_information = result.newest_stats.MinNormalInformation();
-    out->degenerate = out->min_normal_information < options_.association.degeneracy_threshold;
-  }
-  counters_.window_restarts = im.window->counters().restarts;
-  counters_.window_reintegrations = im.window->counters().reintegrations;
-  if (result.status.ok() && IsFinite(result.state, result.covariance)) {
-    x = result.state;
-    P = result.covariance;
-    prop.SetState(x, P);
-    out->updated = result.updated;
-    if (out->updated) {
-      ++counters_.scans_updated;
-      if (out->degenerate) ++counters_.scans_degenerate;
-      im.previous_degenerate = out->degenerate;
-    }
-  } else if (enough_points) {
-    ++counters_.updates_failed;
-    out->update_error = result.status.ok() ? "non-finite posterior" : result.status.message();
-  }
 }
 
 }  // namespace swarmlio::lio

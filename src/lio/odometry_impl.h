@@ -7,7 +7,6 @@
 #include <memory>
 #include <vector>
 
-#include "swarmlio/lio/esikf_update.h"
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/in_flight_alignment.h"
@@ -15,8 +14,7 @@
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/odometry.h"
 #include "swarmlio/lio/preprocess.h"
-#include "swarmlio/lio/scan_association.h"
-#include "window_smoother.h"
+#include "src/lio/back_end.h"
 
 namespace swarmlio::lio {
 namespace internal {
@@ -44,9 +42,7 @@ struct Odometry::Impl {
   std::unique_ptr<ImuPropagator> propagator;
   std::unique_ptr<Preprocess> preprocess;
   LocalMap map;
-  ScanAssociator associator;
-  EsikfUpdate update;
-  std::unique_ptr<internal::WindowSmoother> window;  // estimator: window
+  std::unique_ptr<internal::BackEnd> back_end;  // filter or window (options.estimator)
   std::deque<ImuSample> imu_queue;                   // after initialization, not yet propagated
   InputSynchronizer input;  // scans waiting for the IMU, the IMU stamps' order
   std::deque<PendingScan> static_start_scans;  // before initialization (map seeding)
@@ -59,17 +55,13 @@ struct Odometry::Impl {
   int64_t seed_window_start_ns = 0;
   internal::InFlightProbe probe;
   bool previous_degenerate = false;  // the last updated scan's flag (front end)
-  bool map_was_empty = false;        // the filter's map before this scan's update
   ScanContext probe_scan;            // scratch of ProcessReadyScans
   // Scratch reused between scans.
   std::vector<PointXYZT> points_in_b;
   std::vector<Eigen::Vector3d> undistorted;
 
   Impl(const OdometryOptions& options)
-      : map(options.map),
-        associator(&map, options.association),
-        update(options.update),
-        input(options.max_queued_scans) {}
+      : map(options.map), input(options.max_queued_scans) {}
 };
 
 }  // namespace swarmlio::lio

@@ -140,11 +140,7 @@ Status Odometry::RestartFromInFlightStart(const ImuInitialization& start) {
   Impl& im = *impl_;
   SWARMLIO_RETURN_IF_ERROR(im.propagator->Reset(start));
   im.map = LocalMap(options_.map);
-  if (im.window != nullptr) {
-    SWARMLIO_RETURN_IF_ERROR(internal::WindowSmoother::Create(options_.window, options_.propagation,
-                                                              options_.association, options_.update,
-                                                              &im.map, &im.window));
-  }
+  SWARMLIO_RETURN_IF_ERROR(CreateBackEnd());
   im.imu_queue.assign(im.probe.imu.begin(), im.probe.imu.end());
   im.input.ReplayScans(im.probe.scans);
   im.previous_degenerate = false;

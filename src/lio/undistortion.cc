@@ -7,7 +7,7 @@
 #include "swarmlio/common/check.h"
 #include "swarmlio/math/so3.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 // Index of the pose whose interval holds t (seconds after poses[0]):
@@ -155,4 +155,4 @@ Status UndistortPoints(const std::vector<lio::PointXYZT>& points_in_b,
   return Status::Ok();
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -5,8 +5,8 @@
 namespace swarmlio::live {
 namespace {
 
-ImuInput ToInput(const Eigen::Vector3d& w, const Eigen::Vector3d& a, double acceleration_to_m_s2) {
-  ImuInput u;
+lio::ImuInput ToInput(const Eigen::Vector3d& w, const Eigen::Vector3d& a, double acceleration_to_m_s2) {
+  lio::ImuInput u;
   u.angular_velocity_rad_s = w;
   u.specific_force_m_s2 = acceleration_to_m_s2 * a;
   return u;
@@ -35,17 +35,17 @@ void ImuRateOdometry::ResetToScan(const EgoState& state, int64_t stamp_ns,
 }
 
 void ImuRateOdometry::StepTo(const Sample& next, double acceleration_to_m_s2) {
-  const ImuInput u_next =
+  const lio::ImuInput u_next =
       ToInput(next.angular_velocity_rad_s, next.linear_acceleration, acceleration_to_m_s2);
-  ImuInput u = u_next;
+  lio::ImuInput u = u_next;
   if (has_previous_ && previous_.stamp_ns < next.stamp_ns) {
-    const ImuInput u_previous = ToInput(previous_.angular_velocity_rad_s,
+    const lio::ImuInput u_previous = ToInput(previous_.angular_velocity_rad_s,
                                         previous_.linear_acceleration, acceleration_to_m_s2);
-    u = MidpointInput(u_previous, previous_.stamp_ns, u_next, next.stamp_ns, stamp_ns_,
+    u = lio::MidpointInput(u_previous, previous_.stamp_ns, u_next, next.stamp_ns, stamp_ns_,
                       next.stamp_ns);
   }
   const double dt_s = static_cast<double>(next.stamp_ns - stamp_ns_) * 1e-9;
-  if (dt_s > 0.0) state_ = PropagateEgo(state_, u, dt_s);
+  if (dt_s > 0.0) state_ = lio::PropagateEgo(state_, u, dt_s);
   stamp_ns_ = next.stamp_ns;
   previous_ = next;
   has_previous_ = true;

@@ -6,7 +6,7 @@
 
 namespace swarmlio::swarm::internal {
 
-void DeadReckoningTrack::Append(const std::vector<ImuPose>& poses, double keep_s) {
+void DeadReckoningTrack::Append(const std::vector<lio::ImuPose>& poses, double keep_s) {
   if (poses.size() < 2) return;
   // Time going back (a new log) or a gap of more than 50 ms (dropped scans):
   // start over, so the history stays contiguous; a shorter gap is bridged

@@ -30,7 +30,7 @@ class DeadReckoningTrack {
  public:
   /// Appends one scan's propagated poses (ImuPropagator::scan_poses()): pose
   /// k's acceleration holds until pose k + 1. Keeps the last `keep_s` seconds.
-  void Append(const std::vector<ImuPose>& poses, double keep_s);
+  void Append(const std::vector<lio::ImuPose>& poses, double keep_s);
 
   /// The integrals over [t_j, t_k] with weight (s - t_j); false when the
   /// history does not cover [t_j, t_k] or t_j > t_k.

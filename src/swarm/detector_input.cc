@@ -7,17 +7,17 @@
 #include "teammate_state.h"
 
 namespace swarmlio::swarm::internal {
-Status DetectorInput::Make(const LidarScan& raw, int64_t t_k, const std::vector<ImuPose>& poses,
+Status DetectorInput::Make(const LidarScan& raw, int64_t t_k, const std::vector<lio::ImuPose>& poses,
                            const SwarmState& x, const teammate::ScanResult& last_detection,
                            int64_t last_detection_ns, std::vector<teammate::ScanPoint>* points) {
   const Eigen::Matrix3d R_imu_lidar = lidar_.QuaternionImuLidar().toRotationMatrix();
   Select(raw, t_k, x, last_detection, last_detection_ns, R_imu_lidar);
   SWARMLIO_RETURN_IF_ERROR(
-      UndistortScan(selected_, poses, R_imu_lidar, lidar_.p_lidar_in_imu_m, &undistorted_));
+      lio::UndistortScan(selected_, poses, R_imu_lidar, lidar_.p_lidar_in_imu_m, &undistorted_));
   const double end_offset_s = ToSeconds(t_k - raw.stamp_ns);
   points->resize(undistorted_.size());
   for (size_t k = 0; k < undistorted_.size(); ++k) {
-    const UndistortedPoint& u = undistorted_[k];
+    const lio::UndistortedPoint& u = undistorted_[k];
     teammate::ScanPoint& p = (*points)[k];
     p.p_in_b = u.p_in_b_end.cast<float>();
     p.reflectivity = u.reflectivity;

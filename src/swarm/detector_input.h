@@ -28,7 +28,7 @@ class DetectorInput {
   /// The detector's points of `raw` (t_k: its end, `poses`: propagated over
   /// it), given the predicted state `x` and the trackers of the last
   /// detection (made at last_detection_ns).
-  Status Make(const LidarScan& raw, int64_t t_k, const std::vector<ImuPose>& poses,
+  Status Make(const LidarScan& raw, int64_t t_k, const std::vector<lio::ImuPose>& poses,
               const SwarmState& x, const teammate::ScanResult& last_detection,
               int64_t last_detection_ns, std::vector<teammate::ScanPoint>* points);
 
@@ -43,7 +43,7 @@ class DetectorInput {
   SwarmOptions swarm_;
   LidarOptions lidar_;
   LidarScan selected_;
-  std::vector<UndistortedPoint> undistorted_;
+  std::vector<lio::UndistortedPoint> undistorted_;
 };
 
 }  // namespace swarmlio::swarm::internal

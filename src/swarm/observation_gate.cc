@@ -29,10 +29,10 @@ bool ObservationGate::Add(std::unique_ptr<ceres::CostFunction> cost, int teammat
     std::vector<double> T(GlobalExtrinsic::kAmbientSize);
     x_->teammate(teammate_id).ToParameters(T.data());
     model_.Add(std::make_unique<ConstantBlockCost>(std::move(cost), 1, std::move(T)),
-               {StateKey::Ego()});
+               {lio::StateKey::Ego()});
     return true;
   }
-  model_.Add(std::move(cost), {StateKey::Ego(), StateKey::Extrinsic(teammate_id)});
+  model_.Add(std::move(cost), {lio::StateKey::Ego(), lio::StateKey::Extrinsic(teammate_id)});
   (frozen_ ? considered_ : estimated_).insert(teammate_id);
   return true;
 }

@@ -22,14 +22,14 @@ namespace swarmlio::swarm::internal {
 // The mutual observations of one scan: factors built at the front end; the
 // update re-evaluates them at every iteration (their residuals are exact
 // functions of the state; only the noise is fixed at the prediction).
-class MutualObservationModel final : public MeasurementModel {
+class MutualObservationModel final : public lio::MeasurementModel {
  public:
   const char* name() const override { return "mutual_observation"; }
-  Status Linearize(const SwarmState&, std::vector<ResidualTerm>* terms) override {
+  Status Linearize(const SwarmState&, std::vector<lio::ResidualTerm>* terms) override {
     for (size_t k = 0; k < costs_.size(); ++k) terms->push_back({costs_[k].get(), blocks_[k]});
     return Status::Ok();
   }
-  bool ReleaseTerms(std::vector<OwnedResidualTerm>* terms) override {
+  bool ReleaseTerms(std::vector<lio::OwnedResidualTerm>* terms) override {
     for (size_t k = 0; k < costs_.size(); ++k) {
       terms->push_back({std::move(costs_[k]), std::move(blocks_[k])});
     }
@@ -40,7 +40,7 @@ class MutualObservationModel final : public MeasurementModel {
     costs_.clear();
     blocks_.clear();
   }
-  void Add(std::unique_ptr<ceres::CostFunction> cost, std::vector<StateKey> blocks) {
+  void Add(std::unique_ptr<ceres::CostFunction> cost, std::vector<lio::StateKey> blocks) {
     costs_.push_back(std::move(cost));
     blocks_.push_back(std::move(blocks));
   }
@@ -48,7 +48,7 @@ class MutualObservationModel final : public MeasurementModel {
 
  private:
   std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
-  std::vector<std::vector<StateKey>> blocks_;
+  std::vector<std::vector<lio::StateKey>> blocks_;
 };
 
 // A covariance from the network or the detector, made symmetric positive

@@ -6,10 +6,10 @@
 #include <unordered_map>
 #include <utility>
 
+#include "factors/term_linearizer.h"
+
 namespace swarmlio {
 namespace {
-
-using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 // One parameter block of the system, in [kept | marginalized] order.
 struct Block {
@@ -56,45 +56,17 @@ bool ApplyLoss(const ceres::LossFunction& loss,
 }
 
 // Evaluates one residual block at the current values: the residual and each
-// block's tangent Jacobian (ambient Jacobian times PlusJacobian), with the
-// loss applied.
+// block's tangent Jacobian (factors/term_linearizer.h), with the loss applied.
 Status Linearize(const MarginalizationResidualBlock& residual_block,
                  const std::vector<const Block*>& blocks,
                  Eigen::VectorXd* r,
                  std::vector<Eigen::MatrixXd>* tangent_jacobians) {
-  const ceres::CostFunction& cost = *residual_block.cost_function;
-  const int m = cost.num_residuals();
-  const size_t num_blocks = blocks.size();
-  std::vector<RowMajorMatrix> ambient(num_blocks);
-  std::vector<double*> jacobian_pointers(num_blocks);
-  for (size_t i = 0; i < num_blocks; ++i) {
-    ambient[i].resize(m, blocks[i]->ambient);
-    jacobian_pointers[i] = ambient[i].data();
-  }
-  r->resize(m);
-  if (!cost.Evaluate(residual_block.parameter_blocks.data(), r->data(), jacobian_pointers.data())) {
-    return Status::FailedPrecondition("the cost function failed to evaluate");
-  }
-  if (!r->allFinite()) return Status::FailedPrecondition("the residual is not finite");
-  tangent_jacobians->resize(num_blocks);
-  for (size_t i = 0; i < num_blocks; ++i) {
-    if (!ambient[i].allFinite()) {
-      return Status::FailedPrecondition("the Jacobian of block " + std::to_string(i) +
-                                        " is not finite");
-    }
-    const ceres::Manifold* manifold = blocks[i]->manifold;
-    if (manifold == nullptr) {
-      (*tangent_jacobians)[i] = ambient[i];
-      continue;
-    }
-    RowMajorMatrix plus_jacobian(blocks[i]->ambient, blocks[i]->tangent);
-    if (!manifold->PlusJacobian(blocks[i]->values, plus_jacobian.data()) ||
-        !plus_jacobian.allFinite()) {
-      return Status::FailedPrecondition("the PlusJacobian of block " + std::to_string(i) +
-                                        " failed");
-    }
-    (*tangent_jacobians)[i] = ambient[i] * plus_jacobian;
-  }
+  std::vector<const ceres::Manifold*> manifolds;
+  manifolds.reserve(blocks.size());
+  for (const Block* block : blocks) manifolds.push_back(block->manifold);
+  SWARMLIO_RETURN_IF_ERROR(LinearizeTerm(*residual_block.cost_function,
+                                         residual_block.parameter_blocks.data(), manifolds, r,
+                                         tangent_jacobians));
   if (residual_block.loss_function != nullptr) {
     if (!ApplyLoss(*residual_block.loss_function, r, tangent_jacobians) || !r->allFinite()) {
       return Status::FailedPrecondition("the loss function is not finite");

@@ -11,29 +11,29 @@ using namespace imu_preintegration_test;  // NOLINT(build/namespaces): the fixtu
 // --- options and input errors ----------------------------------------------
 
 TEST(ImuPreintegration, RejectsInvalidOptions) {
-  std::unique_ptr<ImuPreintegration> pre;
-  EXPECT_TRUE(ImuPreintegration::Create(DefaultOptions(), &pre).ok());
-  ImuPreintegrationOptions options;
+  std::unique_ptr<lio::ImuPreintegration> pre;
+  EXPECT_TRUE(lio::ImuPreintegration::Create(DefaultOptions(), &pre).ok());
+  lio::ImuPreintegrationOptions options;
   options.process_noise.gyro_bias_cov_rad2_s4 = 0.0;  // valid for the filter, singular here
-  Status status = ImuPreintegration::Create(options, &pre);
+  Status status = lio::ImuPreintegration::Create(options, &pre);
   EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
   EXPECT_NE(status.message().find("process_noise.gyro_bias_cov_rad2_s4"), std::string::npos)
       << status.message();
-  options = ImuPreintegrationOptions();
+  options = lio::ImuPreintegrationOptions();
   options.gravity_stddev_floor_m_s2 = 0.0;
-  status = ImuPreintegration::Create(options, &pre);
+  status = lio::ImuPreintegration::Create(options, &pre);
   EXPECT_NE(status.message().find("gravity_stddev_floor_m_s2"), std::string::npos)
       << status.message();
-  options = ImuPreintegrationOptions();
+  options = lio::ImuPreintegrationOptions();
   options.max_gap_s = -1.0;
-  EXPECT_FALSE(ImuPreintegration::Create(options, &pre).ok());
+  EXPECT_FALSE(lio::ImuPreintegration::Create(options, &pre).ok());
 }
 
 TEST(ImuPreintegration, HandlesSamplesLikeThePropagator) {
   Sampler s(13);
   const Motion m(&s);
-  std::unique_ptr<ImuPreintegration> pre;
-  ASSERT_TRUE(ImuPreintegration::Create(DefaultOptions(), &pre).ok());
+  std::unique_ptr<lio::ImuPreintegration> pre;
+  ASSERT_TRUE(lio::ImuPreintegration::Create(DefaultOptions(), &pre).ok());
   // The last sample must not be after the start.
   EXPECT_EQ(pre->Reset(kImuPeriodNs - 1, m.Sample(kImuPeriodNs), 1.0, m.b_g, m.b_a).code(),
             Status::Code::kInvalidArgument);

@@ -60,8 +60,8 @@ TEST(ImuPreintegration, RestartChainsConsecutiveIntervals) {
   second.t_k_ns = first.t_k1_ns;
   second.t_k1_ns = 211'700'000;
   // One object: [t_k, t_k+1], Restart(), [t_k+1, t_k+2].
-  std::unique_ptr<ImuPreintegration> pre;
-  ASSERT_TRUE(ImuPreintegration::Create(DefaultOptions(), &pre).ok());
+  std::unique_ptr<lio::ImuPreintegration> pre;
+  ASSERT_TRUE(lio::ImuPreintegration::Create(DefaultOptions(), &pre).ok());
   int64_t k = first.t_k_ns / kImuPeriodNs;
   ASSERT_TRUE(pre->Reset(first.t_k_ns, m.Sample(k * kImuPeriodNs), 1.0, m.b_g, m.b_a).ok());
   for (const Window* w : {&first, &second}) {

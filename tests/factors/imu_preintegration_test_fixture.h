@@ -95,9 +95,9 @@ inline FilterRun RunPropagator(const Motion& m,
                         const Window& w,
                         const Eigen::MatrixXd& P_k,
                         const EgoState* x_k_override = nullptr,
-                        const ImuPropagatorOptions& options = {}) {
-  std::unique_ptr<ImuPropagator> prop;
-  EXPECT_TRUE(ImuPropagator::Create(options, &prop).ok());
+                        const lio::ImuPropagatorOptions& options = {}) {
+  std::unique_ptr<lio::ImuPropagator> prop;
+  EXPECT_TRUE(lio::ImuPropagator::Create(options, &prop).ok());
   SwarmState x0;
   x0.ego = m.State(0.0);
   EXPECT_TRUE(
@@ -118,17 +118,17 @@ inline FilterRun RunPropagator(const Motion& m,
   return {x_k.ego, prop->state().ego, prop->covariance()};
 }
 
-inline ImuPreintegrationOptions DefaultOptions() { return ImuPreintegrationOptions(); }
+inline lio::ImuPreintegrationOptions DefaultOptions() { return lio::ImuPreintegrationOptions(); }
 
 // The preintegration of the same samples over [t_k, t_k+1].
-inline std::unique_ptr<ImuPreintegration> Preintegrate(
+inline std::unique_ptr<lio::ImuPreintegration> Preintegrate(
     const Motion& m,
     const Window& w,
     const Eigen::Vector3d& gyro_bias,
     const Eigen::Vector3d& accel_bias,
-    const ImuPreintegrationOptions& options = DefaultOptions()) {
-  std::unique_ptr<ImuPreintegration> pre;
-  EXPECT_TRUE(ImuPreintegration::Create(options, &pre).ok());
+    const lio::ImuPreintegrationOptions& options = DefaultOptions()) {
+  std::unique_ptr<lio::ImuPreintegration> pre;
+  EXPECT_TRUE(lio::ImuPreintegration::Create(options, &pre).ok());
   int64_t k = w.t_k_ns / kImuPeriodNs;  // the last sample at or before t_k
   EXPECT_TRUE(pre->Reset(w.t_k_ns, m.Sample(k * kImuPeriodNs), m.acceleration_to_m_s2, gyro_bias,
                          accel_bias)

@@ -18,7 +18,7 @@
 #include "swarmlio/lio/esikf_update.h"
 #include "swarmlio/math/so3.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using esikf_test::Sampler;
@@ -383,4 +383,4 @@ TEST(EsikfMutualUpdate, ResidualBlockNamingAnAbsentTeammateIsAnError) {
 }
 
 }  // namespace
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

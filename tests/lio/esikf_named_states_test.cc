@@ -15,7 +15,7 @@
 #include "swarmlio/lio/esikf_update.h"
 #include "swarmlio/lio/state_key.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using esikf_test::Sampler;
@@ -110,4 +110,4 @@ TEST(EsikfNamedStates, ARelativePoseToAPastScanIsRefused) {
 }
 
 }  // namespace
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -18,7 +18,7 @@
 #include "swarmlio/math/so3.h"
 #include "swarmlio/state/swarm_state.h"
 
-namespace swarmlio::esikf_test {
+namespace swarmlio::lio::esikf_test {
 
 class Sampler {
  public:
@@ -128,4 +128,4 @@ inline void PlaneRows(const SwarmState& x, const std::vector<PlaneCorrespondence
   }
 }
 
-}  // namespace swarmlio::esikf_test
+}  // namespace swarmlio::lio::esikf_test

@@ -19,7 +19,7 @@
 #include "esikf_test_util.h"
 #include "swarmlio/math/so3.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using esikf_test::IekfStep;
@@ -255,4 +255,4 @@ TEST(EsikfUpdate, RejectsABadCovarianceOrLayout) {
 }
 
 }  // namespace
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

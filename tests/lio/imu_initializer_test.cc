@@ -10,7 +10,7 @@
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/math/so3.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using L = ErrorStateLayout;
@@ -387,4 +387,4 @@ TEST(ImuInitializer, InFlightStartRotatesTheSpecificForceIntoG) {
 }
 
 }  // namespace
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -14,7 +14,7 @@
 #include "swarmlio/testing/jacobian_check.h"
 #include "tests/test_utils/helix_trajectory.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 using L = ErrorStateLayout;
@@ -416,4 +416,4 @@ TEST(ImuPropagator, MonteCarloErrorMatchesCovariance) {
 }
 
 }  // namespace
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

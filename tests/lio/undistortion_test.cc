@@ -12,7 +12,7 @@
 #include "swarmlio/math/so3.h"
 #include "tests/test_utils/helix_trajectory.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 namespace {
 
 constexpr int64_t kImuPeriodNs = 5'000'000;    // 200 Hz
@@ -212,4 +212,4 @@ TEST(Undistortion, RejectsMissingOrUnsortedPoses) {
 }
 
 }  // namespace
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -110,7 +110,7 @@ Status Rewrite(const std::string& in, const std::string& out, const io::BagWrite
 struct RunResult {
   double rmse_m = 0.0;  // vs the original ground truth (in G)
   eval::FrameCheck frame;
-  ImuInitialization init;
+  lio::ImuInitialization init;
   io::ReadStats stats;
   std::string imu_topic, lidar_topic, ground_truth_topic;
 };
@@ -219,7 +219,7 @@ std::vector<PoseStamped>* ForeignBagTest::truth_spinning_ = nullptr;
 // with the ground truth in a mocap-like world frame.
 TEST_F(ForeignBagTest, SignFlippedImuAndForeignTopicsTrackLikeTheOriginal) {
   const RunResult normal = Run(Input(mid360_, mid360_.bag), *truth_mid360_);
-  EXPECT_EQ(normal.init.reported_direction, SpecificForceDirection::kUp);
+  EXPECT_EQ(normal.init.reported_direction, lio::SpecificForceDirection::kUp);
   EXPECT_TRUE(normal.init.sign_warning.empty()) << normal.init.sign_warning;
   EXPECT_TRUE(normal.frame.same_frame) << normal.frame.Summary();
 
@@ -231,7 +231,7 @@ TEST_F(ForeignBagTest, SignFlippedImuAndForeignTopicsTrackLikeTheOriginal) {
   driver::DroneInput flipped_input = Input(mid360_, flipped_bag);
   flipped_input.odometry.imu_init.acceleration_sign = 0;  // auto
   const RunResult flipped = Run(flipped_input, *truth_mid360_);
-  EXPECT_EQ(flipped.init.reported_direction, SpecificForceDirection::kDown);
+  EXPECT_EQ(flipped.init.reported_direction, lio::SpecificForceDirection::kDown);
   EXPECT_TRUE(flipped.init.sign_detected);
   EXPECT_EQ(flipped.init.acceleration_sign, -1);
 

@@ -40,7 +40,7 @@ TEST(Manifest, ReadsDronesPresetsAndOverrides) {
   // Sensor-dependent defaults survive the overrides.
   EXPECT_EQ(m.drones[0].odometry.map.leaf_size_m, 0.25);
   EXPECT_EQ(m.drones[0].odometry.imu_init.acceleration_unit,
-            AccelerationUnitSetting::kStandardGravity);
+            lio::AccelerationUnitSetting::kStandardGravity);
   EXPECT_EQ(m.drones[1].bag_path, "/abs/b.bag");
   EXPECT_EQ(m.drones[1].ground_truth_path, "");
   EXPECT_EQ(m.drones[1].bag.imu_topic, "/mavros/imu/data");

@@ -29,11 +29,11 @@ Eigen::Matrix3d Attitude(double t) { return so3::Exp(Eigen::Vector3d(0.0, 0.0, 0
 // acceleration and attitude of the interval to pose k + 1 (its midpoint). An
 // update before the scan moved the position by `offset`, which must not
 // matter: only accelerations enter.
-std::vector<ImuPose> Scan(int64_t t0_ns, int64_t t1_ns, const Eigen::Vector3d& offset) {
-  std::vector<ImuPose> poses;
+std::vector<lio::ImuPose> Scan(int64_t t0_ns, int64_t t1_ns, const Eigen::Vector3d& offset) {
+  std::vector<lio::ImuPose> poses;
   for (int64_t t = t0_ns; t <= t1_ns; t += kStepNs) {
     const double mid = Sec(t) + 0.5 * Sec(kStepNs);
-    ImuPose p;
+    lio::ImuPose p;
     p.stamp_ns = t;
     p.p_b_in_G = offset + Position(Sec(t));
     p.acc_in_G_m_s2 = Acceleration(mid);

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "factors/relative_pose_factor.h"
-#include "src/lio/window_smoother.h"
+#include "src/window/window_smoother.h"
 #include "swarmlio/lio/state_key.h"
 
 namespace swarmlio::lio::internal {

@@ -50,7 +50,7 @@
 #include "swarmlio/common/status.h"
 #include "swarmlio/state/swarm_state.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 struct EsikfUpdateOptions {
   /// Outer iterations (re-association + Gauss-Newton step). FAST-LIO2 uses 4.
@@ -179,4 +179,4 @@ class PlaneMeasurementModel final : public MeasurementModel {
   PoseInformationFactor compressed_;  // what the Ceres problem holds (6 rows)
 };
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -34,7 +34,7 @@
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/swarm_state.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 /// Acceleration unit as configured for initialization: a fixed unit, or
 /// detected from |mean a_m| at the static start (~1 -> g, ~9.8 -> m/s^2).
@@ -55,44 +55,44 @@ enum class SpecificForceDirection {
 /// Unit vector of `axis` (zero for kNone).
 Eigen::Vector3d UpAxisVector(ImuUpAxis axis);
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio
 
 namespace swarmlio::config {
 
 template <>
-struct EnumTraits<AccelerationUnitSetting> {
-  static constexpr std::array<std::pair<AccelerationUnitSetting, const char*>, 3> kNames{{
-      {AccelerationUnitSetting::kMetersPerSecondSquared, "m_s2"},
-      {AccelerationUnitSetting::kStandardGravity, "g"},
-      {AccelerationUnitSetting::kAuto, "auto"},
+struct EnumTraits<lio::AccelerationUnitSetting> {
+  static constexpr std::array<std::pair<lio::AccelerationUnitSetting, const char*>, 3> kNames{{
+      {lio::AccelerationUnitSetting::kMetersPerSecondSquared, "m_s2"},
+      {lio::AccelerationUnitSetting::kStandardGravity, "g"},
+      {lio::AccelerationUnitSetting::kAuto, "auto"},
   }};
 };
 
 template <>
-struct EnumTraits<ImuUpAxis> {
-  static constexpr std::array<std::pair<ImuUpAxis, const char*>, 7> kNames{{
-      {ImuUpAxis::kNone, "none"},
-      {ImuUpAxis::kPlusX, "+x"},
-      {ImuUpAxis::kMinusX, "-x"},
-      {ImuUpAxis::kPlusY, "+y"},
-      {ImuUpAxis::kMinusY, "-y"},
-      {ImuUpAxis::kPlusZ, "+z"},
-      {ImuUpAxis::kMinusZ, "-z"},
+struct EnumTraits<lio::ImuUpAxis> {
+  static constexpr std::array<std::pair<lio::ImuUpAxis, const char*>, 7> kNames{{
+      {lio::ImuUpAxis::kNone, "none"},
+      {lio::ImuUpAxis::kPlusX, "+x"},
+      {lio::ImuUpAxis::kMinusX, "-x"},
+      {lio::ImuUpAxis::kPlusY, "+y"},
+      {lio::ImuUpAxis::kMinusY, "-y"},
+      {lio::ImuUpAxis::kPlusZ, "+z"},
+      {lio::ImuUpAxis::kMinusZ, "-z"},
   }};
 };
 
 template <>
-struct EnumTraits<SpecificForceDirection> {
-  static constexpr std::array<std::pair<SpecificForceDirection, const char*>, 3> kNames{{
-      {SpecificForceDirection::kUp, "up"},
-      {SpecificForceDirection::kDown, "down"},
-      {SpecificForceDirection::kUndetermined, "undetermined"},
+struct EnumTraits<lio::SpecificForceDirection> {
+  static constexpr std::array<std::pair<lio::SpecificForceDirection, const char*>, 3> kNames{{
+      {lio::SpecificForceDirection::kUp, "up"},
+      {lio::SpecificForceDirection::kDown, "down"},
+      {lio::SpecificForceDirection::kUndetermined, "undetermined"},
   }};
 };
 
 }  // namespace swarmlio::config
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 struct ImuInitializerOptions {
   // Samples averaged (FAST-LIO MAX_INI_COUNT); used when window_duration_s == 0.
@@ -271,4 +271,4 @@ class ImuInitializer {
   int num_skipped_out_of_order_ = 0;
 };
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

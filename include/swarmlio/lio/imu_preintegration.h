@@ -42,7 +42,7 @@
 #include "swarmlio/lio/process_noise_options.h"
 #include "swarmlio/sensors/measurements.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 struct ImuPreintegrationOptions {
   /// The filter's process noise (same meaning: variance per IMU interval,
@@ -170,4 +170,4 @@ class ImuPreintegration {
   int num_gaps_ = 0;
 };
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -33,7 +33,7 @@
 #include "swarmlio/state/state_layout.h"
 #include "swarmlio/state/swarm_state.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 struct ImuInitialization;
 
@@ -197,4 +197,4 @@ class ImuPropagator {
   int num_gaps_ = 0;
 };
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

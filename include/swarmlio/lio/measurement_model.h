@@ -28,7 +28,7 @@
 #include "swarmlio/lio/state_key.h"
 #include "swarmlio/state/swarm_state.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 /// One residual block a model contributes at one iteration.
 struct ResidualTerm {
@@ -79,4 +79,4 @@ class MeasurementModel {
   }
 };
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

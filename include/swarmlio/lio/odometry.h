@@ -51,10 +51,6 @@
 #include "swarmlio/state/swarm_state.h"
 
 namespace swarmlio::lio {
-namespace internal {
-struct WindowSolveResult;
-}  // namespace internal
-
 /// Wall time of each stage of one scan [s].
 struct ScanTimings {
   double preprocess_s = 0.0;   // filters + voxel downsampling
@@ -229,22 +225,9 @@ class Odometry {
   // A scan of an in-flight probe pass: the stages without front end and
   // output; its position feeds the pass's fit.
   void ProcessProbeScan(ScanContext* scan);
-  // Step 4 with each back end: scan->x, P in = the prediction, out = the
-  // posterior (or the prediction when not updated). The filter's map
-  // insertion is Commit's; the window inserts the scans that leave it here.
-  void UpdateWithFilter(const UpdateRequest& request, ScanContext* scan);
-  void UpdateWithWindow(const UpdateRequest& request, ScanContext* scan);
-  // The window's solution into the scan's state and output.
-  void TakeWindowSolution(const internal::WindowSolveResult& result, bool enough_points,
-                          ScanContext* scan);
-  // Registers the points with x, inserts all but the excluded ones and those
-  // listed in skip_indices into the map (moving its box to x) and returns how
-  // many were excluded. registered_in_G (cleared) gets every point not
-  // excluded.
-  int InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const EgoState& x,
-                 const std::vector<ExcludedRegion>& excluded,
-                 std::vector<Eigen::Vector3d>* registered_in_G,
-                 const std::vector<int>* skip_indices = nullptr);
+  // The back end options_.estimator names (filter or window), on the map
+  // and the propagator; replaces any previous one.
+  Status CreateBackEnd();
 
   OdometryOptions options_;
   LidarOptions lidar_;

@@ -25,7 +25,7 @@
 
 #include "swarmlio/common/option_fields.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 struct ProcessNoiseOptions {
   double gyro_cov_rad2_s2 = 0.1;                 // n_g variance [(rad/s)^2] (FAST-LIO gyr_cov)
@@ -58,4 +58,4 @@ struct ProcessNoiseOptions {
   std::string Validate() const { return config::ValidateFields(*this); }
 };
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -18,7 +18,7 @@
 #include <cstdint>
 #include <string>
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 class StateKey {
  public:
@@ -70,4 +70,4 @@ inline std::string StateKey::ToString() const {
   return "Extrinsic(" + std::to_string(teammate_id_) + ")";
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -24,7 +24,7 @@
 #include "swarmlio/lio/voxel_filter.h"
 #include "swarmlio/sensors/measurements.h"
 
-namespace swarmlio {
+namespace swarmlio::lio {
 
 /// A motion-compensated point: body (IMU) frame at the scan end time.
 struct UndistortedPoint {
@@ -70,4 +70,4 @@ Status UndistortPoints(const std::vector<lio::PointXYZT>& points_in_b,
                        std::vector<Eigen::Vector3d>* points_in_b_end,
                        UndistortionStats* stats = nullptr);
 
-}  // namespace swarmlio
+}  // namespace swarmlio::lio

@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "factors/term_linearizer.h"
 #include "window_smoother.h"
 #include "window_state.h"
 
@@ -30,28 +31,14 @@ ceres::LinearSolverType ToCeres(WindowLinearSolver solver) {
 }
 
 // Adds J^T J of one residual block at the blocks' current values (tangent
-// Jacobians: ambient Jacobian times PlusJacobian) to H at the blocks' offsets.
+// Jacobians, factors/term_linearizer.h) to H at the blocks' offsets.
 bool AddBlockInformation(const ceres::CostFunction& cost, const std::vector<double*>& blocks,
                          const std::vector<const ceres::Manifold*>& manifolds,
                          const std::vector<int>& offsets, Eigen::MatrixXd* H) {
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const int m = cost.num_residuals();
   const size_t nb = blocks.size();
-  std::vector<RowMajor> ambient(nb);
-  std::vector<double*> jacobians(nb);
-  for (size_t b = 0; b < nb; ++b) {
-    ambient[b].resize(m, manifolds[b]->AmbientSize());
-    jacobians[b] = ambient[b].data();
-  }
-  Eigen::VectorXd residuals(m);
-  if (!cost.Evaluate(blocks.data(), residuals.data(), jacobians.data())) return false;
-  std::vector<Eigen::MatrixXd> tangent(nb);
-  for (size_t b = 0; b < nb; ++b) {
-    RowMajor plus(manifolds[b]->AmbientSize(), manifolds[b]->TangentSize());
-    if (!manifolds[b]->PlusJacobian(blocks[b], plus.data())) return false;
-    tangent[b] = ambient[b] * plus;
-    if (!tangent[b].allFinite()) return false;
-  }
+  Eigen::VectorXd residuals;
+  std::vector<Eigen::MatrixXd> tangent;
+  if (!LinearizeTerm(cost, blocks.data(), manifolds, &residuals, &tangent).ok()) return false;
   for (size_t a = 0; a < nb; ++a) {
     for (size_t b = 0; b < nb; ++b) {
       H->block(offsets[a], offsets[b], tangent[a].cols(), tangent[b].cols()) +=

@@ -1,5 +1,5 @@
 // WindowSmoother: the fixed-lag window back end of lio::Odometry (issue #12,
-// docs/window.md). Internal to swarmlio_lio: the odometry owns it, the map
+// docs/window.md). Internal to swarmlio_window: the odometry owns it, the map
 // and the propagator, and drives it per scan.
 //
 // State: the last K scan states (ego blocks, EgoStateManifold) and one

@@ -1,7 +1,7 @@
-// The state of the fixed-lag window smoother (src/lio/window_smoother.h):
+// The state of the fixed-lag window smoother (src/window/window_smoother.h):
 // its scans, teammate blocks and prior, shared by window_smoother.cc
 // (adding states, marginalization) and window_solve.cc (the solve and the
-// newest covariance). Internal to swarmlio_lio.
+// newest covariance). Internal to swarmlio_window.
 #pragma once
 
 #include <ceres/manifold.h>

@@ -1,0 +1,52 @@
+// WindowBackEnd: the fixed-lag window back end of lio::Odometry
+// (docs/window.md) on the WindowSmoother: the scan's state joins the window,
+// the states beyond K leave it marginalized and enter the map at their
+// final estimates, then the window is solved. The IMU interval between two
+// states is preintegrated from exactly the samples the propagator consumes.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "src/lio/back_end.h"
+#include "src/window/window_smoother.h"
+#include "swarmlio/common/status.h"
+#include "swarmlio/lio/imu_propagator.h"
+#include "swarmlio/lio/local_map.h"
+#include "swarmlio/lio/odometry_options.h"
+
+namespace swarmlio::lio::internal {
+
+class WindowBackEnd final : public BackEnd {
+ public:
+  /// InvalidArgument when the window options do not validate. `map` and
+  /// `propagator` must outlive the back end.
+  static Status Create(const OdometryOptions& options, LocalMap* map, ImuPropagator* propagator,
+                       std::unique_ptr<BackEnd>* back_end);
+
+  void StartInterval(int64_t stamp_ns, const ImuSample& last_sample, double acceleration_to_m_s2,
+                     const EgoState& newest) override;
+  void AddImu(const ImuSample& sample) override;
+  void IntegrateTo(int64_t stamp_ns, const ImuSample* next_sample) override;
+
+  void Update(const UpdateRequest& request, const std::vector<Eigen::Vector3d>& points_in_b,
+              ScanContext* scan, OdometryCounters* counters) override;
+  void Commit(const std::vector<Eigen::Vector3d>&, ScanContext*) override {}
+  void Flush() override;
+
+ private:
+  WindowBackEnd(const OdometryOptions& options, LocalMap* map, ImuPropagator* propagator);
+  // The scans that left the window, at their final estimates (only scans
+  // that a solve updated; docs/window.md "Map").
+  void InsertLeaving(const std::vector<LeavingScan>& leaving);
+  // The window's solution into the scan's state and output.
+  void TakeSolution(const WindowSolveResult& result, bool enough_points, ScanContext* scan,
+                    OdometryCounters* counters);
+
+  OdometryOptions options_;
+  LocalMap* map_;
+  ImuPropagator* propagator_;
+  std::unique_ptr<WindowSmoother> window_;
+};
+
+}  // namespace swarmlio::lio::internal
