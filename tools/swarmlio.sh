@@ -9,7 +9,7 @@
 #                             tests under ThreadSanitizer (docs/network.md, "Fuzzing and sanitizers in CI")
 #   tools/swarmlio.sh fuzz    only the fuzz stage;  tools/swarmlio.sh tsan   only the TSan stage
 #   tools/swarmlio.sh tidy    only the static checks: clang-tidy (.clang-tidy: function size
-#                             and naming) on src/swarm, src/lio, src/window, and no function
+#                             and naming) on src/swarm, src/lio, src/window, src/driver, and no function
 #                             in src/ over 120 lines
 #
 # Environment: BUILD_DIR (default build), ASAN_BUILD_DIR (default build-asan),
@@ -176,7 +176,7 @@ tsan_stage() {
 # repository's .clang-tidy (functions <= 80 lines, naming) on the component
 # and estimator folders, and no function anywhere in src/ over 120 lines
 # (Universal Ctags gives each function's extent).
-TIDY_DIRS=(src/swarm src/lio src/window)
+TIDY_DIRS=(src/swarm src/lio src/window src/driver)
 tidy_stage() {
   log "static checks: clang-tidy on ${TIDY_DIRS[*]}; function size in src/"
   local files
