@@ -83,8 +83,8 @@ struct LiveDrone::Impl : driver::DriverSink {
   void OnMessages(std::vector<net::SwarmMessage>* messages) override;
   void Send(const Outgoing& out);
   double AccelerationFactor() const {
-    const lio::Odometry& odometry = loop->estimator().odometry();
-    return odometry.initialized() ? odometry.initialization().acceleration_to_m_s2 : 1.0;
+    const swarm::DroneEstimator& estimator = loop->estimator();
+    return estimator.initialized() ? estimator.initialization().acceleration_to_m_s2 : 1.0;
   }
 };
 

@@ -37,59 +37,39 @@ Status DroneRunner::Create(const driver::DroneInput& input, int drone_id,
   return Status::Ok();
 }
 
-ScanRecord ToScanRecord(const lio::ScanOutput& o) {
-  ScanRecord r;
-  r.stamp_ns = o.stamp_ns;
-  r.state = o.state;
-  r.pose_covariance = o.covariance.topLeftCorner<6, 6>();
-  r.velocity_covariance = o.covariance.block<3, 3>(ErrorStateLayout::kVelocity.offset,
-                                                   ErrorStateLayout::kVelocity.offset);
-  r.updated = o.updated;
-  r.held_by_initialization = o.held_by_initialization;
-  r.num_raw_points = o.num_raw_points;
-  r.num_points = o.num_points;
-  r.num_correspondences = o.num_correspondences;
-  r.iterations = o.iterations;
-  r.min_normal_information = o.min_normal_information;
-  r.degenerate = o.degenerate;
-  r.map_size = o.map_size;
-  r.timings = o.timings;
-  return r;
+swarm::DroneOutput KeptOutput(swarm::DroneOutput output) {
+  output.ego.registered_in_G = std::vector<Eigen::Vector3d>();
+  output.ego.update_error = std::string();
+  output.ego.front_end_error = std::string();
+  output.identifications = std::vector<swarm::IdentificationEvent>();
+  output.removed_teammates = std::vector<int>();
+  return output;
 }
 
-ScanRecord ToScanRecord(const swarm::DroneOutput& o) {
-  ScanRecord r = ToScanRecord(o.ego);
-  for (const swarm::TeammateEstimate& e : o.teammates) {
-    TeammateRecord t;
-    t.drone_id = e.drone_id;
-    t.T_Gi_Gj = e.T_Gi_Gj;
-    t.extrinsic_sigma2 = e.extrinsic_covariance.diagonal();
-    t.have_pose = e.have_pose;
-    t.q_Gi_bj = e.q_Gi_bj;
-    t.p_bj_in_Gi = e.p_bj_in_Gi;
-    t.seen = e.seen;
-    t.active_observations = e.active_observations;
-    t.passive_observations = e.passive_observations;
-    r.teammates.push_back(t);
-  }
-  r.active_observations = o.active_observations;
-  r.passive_observations = o.passive_observations;
-  r.rejected_observations = o.rejected_observations;
-  r.extrinsics_frozen = o.extrinsics_frozen;
-  return r;
+namespace {
+
+void AppendIfUpdated(const lio::ScanOutput& s, eval::CovariantTrajectory* out) {
+  if (!s.updated) return;
+  Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
+  T_G_b.linear() = s.state.q_G_b.normalized().toRotationMatrix();
+  T_G_b.translation() = s.state.p_b_in_G;
+  out->poses.stamps_s.push_back(StampSeconds(s.stamp_ns));
+  out->poses.T_G_b.push_back(T_G_b);
+  out->position_covariances.push_back(
+      s.covariance.block<3, 3>(ErrorStateLayout::kPosition.offset, ErrorStateLayout::kPosition.offset));
 }
 
-eval::CovariantTrajectory UpdatedEstimate(const std::vector<ScanRecord>& scans) {
+}  // namespace
+
+eval::CovariantTrajectory UpdatedEstimate(const std::vector<lio::ScanOutput>& scans) {
   eval::CovariantTrajectory out;
-  for (const ScanRecord& s : scans) {
-    if (!s.updated) continue;
-    Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
-    T_G_b.linear() = s.state.q_G_b.normalized().toRotationMatrix();
-    T_G_b.translation() = s.state.p_b_in_G;
-    out.poses.stamps_s.push_back(StampSeconds(s.stamp_ns));
-    out.poses.T_G_b.push_back(T_G_b);
-    out.position_covariances.push_back(s.pose_covariance.bottomRightCorner<3, 3>());
-  }
+  for (const lio::ScanOutput& s : scans) AppendIfUpdated(s, &out);
+  return out;
+}
+
+eval::CovariantTrajectory UpdatedEstimate(const std::vector<swarm::DroneOutput>& scans) {
+  eval::CovariantTrajectory out;
+  for (const swarm::DroneOutput& s : scans) AppendIfUpdated(s.ego, &out);
   return out;
 }
 
@@ -158,8 +138,8 @@ Status DroneRunner::Finish() {
 
 void DroneRunner::OnOutputs(const std::vector<swarm::DroneOutput>& outputs) {
   for (const swarm::DroneOutput& o : outputs) {
-    scans_.push_back(ToScanRecord(o));
     for (const swarm::IdentificationEvent& e : o.identifications) identifications_.push_back(e);
+    scans_.push_back(KeptOutput(o));
   }
 }
 

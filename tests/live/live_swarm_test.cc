@@ -81,7 +81,7 @@ class RacingClock : public Clock {
 class CollectingSink : public LiveSink {
  public:
   void OnScan(const swarm::DroneOutput& output, const ScanLatency& latency) override {
-    scans.push_back(replay::ToScanRecord(output));
+    scans.push_back(replay::KeptOutput(output));
     latencies_ms.push_back(1e-6 * static_cast<double>(latency.latency_ns()));
   }
   void OnScanDropped(int64_t stamp_ns, ScanDropReason /*reason*/) override {
@@ -93,7 +93,7 @@ class CollectingSink : public LiveSink {
     ++imu_poses;
   }
 
-  std::vector<replay::ScanRecord> scans;
+  std::vector<swarm::DroneOutput> scans;
   std::vector<double> latencies_ms;
   std::vector<int64_t> dropped_stamps_ns;
   int64_t imu_poses = 0;
@@ -220,7 +220,7 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
     EXPECT_EQ(s.datagrams_logged, static_cast<int64_t>(udp[i]->stats().datagrams_received));
     EXPECT_EQ(s.estimator_warnings, 0) << s.first_warning;
     // Every IMU sample reached the estimator; the IMU-rate output is at IMU rate.
-    EXPECT_EQ(drones[i]->estimator().odometry().counters().imu_samples, s.imu_samples);
+    EXPECT_EQ(drones[i]->estimator().odometry_counters().imu_samples, s.imu_samples);
     const double imu_span_s = 1e-9 * static_cast<double>(sinks[i].last_imu_ns - sinks[i].first_imu_ns);
     ASSERT_GT(imu_span_s, 1.0);
     EXPECT_GE(static_cast<double>(sinks[i].imu_poses - 1) / imu_span_s, 195.0);
@@ -244,8 +244,8 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
   for (int i = 0; i < 3; ++i) {
     const std::string& name = manifest_->drones[i].name;
     SCOPED_TRACE(name);
-    const std::vector<replay::ScanRecord>& live = sinks[i].scans;
-    const std::vector<replay::ScanRecord>& again = run->drone(i).scans();
+    const std::vector<swarm::DroneOutput>& live = sinks[i].scans;
+    const std::vector<swarm::DroneOutput>& again = run->drone(i).scans();
     // The same messages reached the estimator (the live channel also decoded
     // the few that arrived after the drone's last record).
     EXPECT_EQ(run->traffic(i).received, drones[i]->stats().messages_delivered);
@@ -254,10 +254,10 @@ TEST_F(LiveSwarmTest, ThreeDronesOverUdpThenOfflineReRunReproducesThem) {
     double max_dp = 0.0, max_dq_deg = 0.0;
     size_t i_live = 0, i_again = 0;
     for (; i_live < live.size() && i_again < again.size();) {  // pair by stamp
-      if (live[i_live].stamp_ns < again[i_again].stamp_ns) { ++i_live; continue; }
-      if (again[i_again].stamp_ns < live[i_live].stamp_ns) { ++i_again; continue; }
-      const EgoState& a = live[i_live].state;
-      const EgoState& b = again[i_again].state;
+      if (live[i_live].ego.stamp_ns < again[i_again].ego.stamp_ns) { ++i_live; continue; }
+      if (again[i_again].ego.stamp_ns < live[i_live].ego.stamp_ns) { ++i_again; continue; }
+      const EgoState& a = live[i_live].ego.state;
+      const EgoState& b = again[i_again].ego.state;
       max_dp = std::max(max_dp, (a.p_b_in_G - b.p_b_in_G).norm());
       max_dq_deg = std::max(max_dq_deg, a.q_G_b.angularDistance(b.q_G_b) * 180.0 / M_PI);
       ++i_live;
@@ -285,7 +285,7 @@ TEST_F(LiveDropTest, FallingBehindDropsWholeScansNeverImu) {
   const Status s = racing.Run(manifest_->drones[0], options);
   ASSERT_TRUE(s.ok()) << s.message();
   const LiveStats& st = racing.drone->stats();
-  const lio::OdometryCounters& c = racing.drone->estimator().odometry().counters();
+  const lio::OdometryCounters& c = racing.drone->estimator().odometry_counters();
   const CollectingSink& sink = racing.sink;
   const int64_t dropped = st.scans_dropped_queue + st.scans_dropped_backlog;
   std::printf("racing clock: %lld scans played, %lld dropped (%lld queue, %lld backlog), %lld "

@@ -410,9 +410,9 @@ TEST(PushSource, OdometryOfTheImuFirstOrderEqualsTheStampOrders) {
 class ScanSink : public LiveSink {
  public:
   void OnScan(const swarm::DroneOutput& output, const ScanLatency& /*latency*/) override {
-    scans.push_back(replay::ToScanRecord(output));
+    scans.push_back(replay::KeptOutput(output));
   }
-  std::vector<replay::ScanRecord> scans;
+  std::vector<swarm::DroneOutput> scans;
 };
 
 class PushSourceOrdering : public ::testing::TestWithParam<PushOrdering> {};
@@ -429,7 +429,7 @@ TEST_P(PushSourceOrdering, LiveDroneFedByPushesReproducesTheOfflineReplay) {
   Status s = replay::SwarmReplay::Create(manifest, &offline);
   ASSERT_TRUE(s.ok()) << s.message();
   ASSERT_TRUE(offline->Run(replay::ReplayOptions()).ok());
-  const std::vector<replay::ScanRecord>& reference = offline->drone(0).scans();
+  const std::vector<swarm::DroneOutput>& reference = offline->drone(0).scans();
   ASSERT_GT(reference.size(), 30u);
 
   SteadyClock clock;
@@ -494,8 +494,8 @@ TEST_P(PushSourceOrdering, LiveDroneFedByPushesReproducesTheOfflineReplay) {
   ASSERT_EQ(sink.scans.size(), reference.size());
   double max_dp = 0.0;
   for (size_t i = 0; i < reference.size(); ++i) {
-    EXPECT_EQ(sink.scans[i].stamp_ns, reference[i].stamp_ns);
-    max_dp = std::max(max_dp, (sink.scans[i].state.p_b_in_G - reference[i].state.p_b_in_G).norm());
+    EXPECT_EQ(sink.scans[i].ego.stamp_ns, reference[i].ego.stamp_ns);
+    max_dp = std::max(max_dp, (sink.scans[i].ego.state.p_b_in_G - reference[i].ego.state.p_b_in_G).norm());
   }
   EXPECT_LE(max_dp, 1e-9);
   std::printf("pushed live (%s order) vs offline replay: %zu scans, max position difference "

@@ -182,8 +182,8 @@ class ForeignBagTest : public ::testing::Test {
     const Status status = run->Run(ReplayOptions());
     EXPECT_TRUE(status.ok()) << status.message();
     const DroneRunner& d = run->drone(0);
-    EXPECT_TRUE(d.odometry().initialized()) << d.odometry().initialization_error();
-    result.init = d.odometry().initialization();
+    EXPECT_TRUE(d.estimator().initialized()) << d.estimator().initialization_error();
+    result.init = d.estimator().initialization();
     result.stats = d.reader().stats();
     result.imu_topic = d.reader().imu_topic();
     result.lidar_topic = d.reader().lidar_topic();

@@ -105,9 +105,9 @@ class InFlightStartTest : public ::testing::Test {
     EXPECT_TRUE(run->Run(ReplayOptions()).ok());
     LateDroneFigures f;
     const DroneRunner& d = run->drone(late);
-    EXPECT_TRUE(d.odometry().initialized());
+    EXPECT_TRUE(d.estimator().initialized());
     const std::vector<PoseStamped>& gt = d.bag_ground_truth();  // T_G0_b, G0 at the log start
-    const int64_t t0 = d.odometry().initialization().stamp_ns;
+    const int64_t t0 = d.estimator().initialization().stamp_ns;
     EXPECT_FALSE(gt.empty());
     if (gt.empty()) return f;
     // Its start: its first record, or its return after the restart.
@@ -116,11 +116,11 @@ class InFlightStartTest : public ::testing::Test {
         (restart ? static_cast<int64_t>(std::llround((offset_s + input.restart_down_s) * 1e9)) : 0);
     f.init_delay_s = 1e-9 * static_cast<double>(t0 - start_ns);
     if (!d.scans().empty()) {
-      f.first_output_s = 1e-9 * static_cast<double>(d.scans().front().stamp_ns - start_ns);
+      f.first_output_s = 1e-9 * static_cast<double>(d.scans().front().ego.stamp_ns - start_ns);
     }
     bool unheld_seen = false;
-    for (const ScanRecord& s : d.scans()) {
-      if (s.held_by_initialization) {
+    for (const swarm::DroneOutput& s : d.scans()) {
+      if (s.ego.held_by_initialization) {
         ++f.held_scans;
         if (unheld_seen) f.held_first = false;
       } else {
@@ -132,34 +132,34 @@ class InFlightStartTest : public ::testing::Test {
     {
       // G0 is gravity-aligned (the log starts at rest, level).
       const Eigen::Vector3d g_true = T_G0_G.linear().transpose() * Eigen::Vector3d(0, 0, -1);
-      const Eigen::Vector3d g_est = d.odometry().initialization().state.g_in_G.normalized();
+      const Eigen::Vector3d g_est = d.estimator().initialization().state.g_in_G.normalized();
       f.init_tilt_deg = std::acos(std::clamp(g_true.dot(g_est), -1.0, 1.0)) * 180.0 / M_PI;
       Eigen::Isometry3d a, b;
       if (PoseAt(gt, t0 - 5'000'000, &a) && PoseAt(gt, t0 + 5'000'000, &b)) {
         const Eigen::Vector3d v_true =
             T_G0_G.linear().transpose() * (b.translation() - a.translation()) / 0.01;
-        f.init_velocity_error_m_s = (d.odometry().initialization().state.v_b_in_G - v_true).norm();
+        f.init_velocity_error_m_s = (d.estimator().initialization().state.v_b_in_G - v_true).norm();
       }
     }
     {
       const DroneRunner& ref = run->drone(late == 0 ? 1 : 0);
       double sse0 = 0.0;
       int n0 = 0;
-      for (const ScanRecord& s : ref.scans()) {
-        if (s.held_by_initialization) ++f.reference_held_scans;
+      for (const swarm::DroneOutput& s : ref.scans()) {
+        if (s.ego.held_by_initialization) ++f.reference_held_scans;
         Eigen::Isometry3d T;
-        if (!PoseAt(ref.bag_ground_truth(), s.stamp_ns, &T)) continue;
-        sse0 += (s.state.p_b_in_G - T.translation()).squaredNorm();
+        if (!PoseAt(ref.bag_ground_truth(), s.ego.stamp_ns, &T)) continue;
+        sse0 += (s.ego.state.p_b_in_G - T.translation()).squaredNorm();
         ++n0;
       }
       f.reference_rmse_m = std::sqrt(sse0 / std::max(n0, 1));
     }
     double sse = 0.0;
     int n = 0;
-    for (const ScanRecord& s : d.scans()) {
+    for (const swarm::DroneOutput& s : d.scans()) {
       Eigen::Isometry3d T_G0_b;
-      if (!PoseAt(gt, s.stamp_ns, &T_G0_b)) continue;
-      sse += (s.state.p_b_in_G - (T_G0_G.inverse() * T_G0_b).translation()).squaredNorm();
+      if (!PoseAt(gt, s.ego.stamp_ns, &T_G0_b)) continue;
+      sse += (s.ego.state.p_b_in_G - (T_G0_G.inverse() * T_G0_b).translation()).squaredNorm();
       ++n;
     }
     EXPECT_GT(n, 50);
@@ -182,7 +182,7 @@ class InFlightStartTest : public ::testing::Test {
       const Eigen::Isometry3d T_true = manifest.drones[i].T_W_G().inverse() * T_W_Gj;
       for (auto s = observer.scans().rbegin(); s != observer.scans().rend(); ++s) {
         const auto t = std::find_if(s->teammates.begin(), s->teammates.end(),
-                                    [&](const TeammateRecord& r) { return r.drone_id == late; });
+                                    [&](const swarm::TeammateEstimate& r) { return r.drone_id == late; });
         if (t == s->teammates.end()) continue;
         const Eigen::Isometry3d E = T_true.inverse() * t->T_Gi_Gj.T_Gi_Gj();
         f.end_error_m[i] = E.translation().norm();

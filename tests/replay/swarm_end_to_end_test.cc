@@ -200,7 +200,7 @@ TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
     const DroneRunner& d = run->drone(i);
     EXPECT_EQ(d.identifications().size(), 2u) << d.input().name;
     ASSERT_FALSE(d.scans().empty());
-    const int64_t t_last = d.scans().back().stamp_ns;
+    const int64_t t_last = d.scans().back().ego.stamp_ns;
     const net::ClockSync* sync = d.estimator().clock_sync();
     ASSERT_NE(sync, nullptr);
     for (int j = 0; j < 3; ++j) {

@@ -100,10 +100,10 @@ void ExpectSameEstimates(const SwarmReplay& a, const SwarmReplay& b) {
     const auto& sb = b.drone(i).scans();
     ASSERT_EQ(sa.size(), sb.size());
     for (size_t k = 0; k < sa.size(); ++k) {
-      ASSERT_EQ(sa[k].stamp_ns, sb[k].stamp_ns);
-      ASSERT_EQ(sa[k].state.p_b_in_G, sb[k].state.p_b_in_G);  // bit for bit
-      ASSERT_EQ(sa[k].state.q_G_b.coeffs(), sb[k].state.q_G_b.coeffs());
-      ASSERT_EQ(sa[k].pose_covariance, sb[k].pose_covariance);
+      ASSERT_EQ(sa[k].ego.stamp_ns, sb[k].ego.stamp_ns);
+      ASSERT_EQ(sa[k].ego.state.p_b_in_G, sb[k].ego.state.p_b_in_G);  // bit for bit
+      ASSERT_EQ(sa[k].ego.state.q_G_b.coeffs(), sb[k].ego.state.q_G_b.coeffs());
+      ASSERT_EQ(sa[k].ego.covariance, sb[k].ego.covariance);
     }
   }
 }
@@ -139,9 +139,9 @@ TEST_F(SwarmReplayTest, SingleAgentAblationFusesNothingButKeepsMessaging) {
     EXPECT_GT(alone->traffic(i).received, 0);
     EXPECT_EQ(alone->drone(i).estimator().counters().active_fused, 0);
     EXPECT_EQ(alone->drone(i).estimator().counters().passive_fused, 0);
-    for (const ScanRecord& r : alone->drone(i).scans()) {
+    for (const swarm::DroneOutput& r : alone->drone(i).scans()) {
       EXPECT_EQ(r.active_observations + r.passive_observations, 0);
-      ASSERT_TRUE(r.state.p_b_in_G.allFinite());
+      ASSERT_TRUE(r.ego.state.p_b_in_G.allFinite());
     }
   }
 }
@@ -171,18 +171,18 @@ TEST_F(SwarmReplayTest, LeavesOutTheListedScans) {
   const auto fewer = Run(options);
   EXPECT_EQ(fewer->drone(1).skipped_scans(), 2);
   EXPECT_EQ(fewer->drone(0).skipped_scans(), 0);
-  const std::vector<ScanRecord>& a = all->drone(1).scans();
-  const std::vector<ScanRecord>& b = fewer->drone(1).scans();
+  const std::vector<swarm::DroneOutput>& a = all->drone(1).scans();
+  const std::vector<swarm::DroneOutput>& b = fewer->drone(1).scans();
   ASSERT_EQ(b.size() + 2, a.size());
   size_t same = 0;
-  while (same < b.size() && b[same].stamp_ns == a[same].stamp_ns &&
-         b[same].state.p_b_in_G == a[same].state.p_b_in_G) {
+  while (same < b.size() && b[same].ego.stamp_ns == a[same].ego.stamp_ns &&
+         b[same].ego.state.p_b_in_G == a[same].ego.state.p_b_in_G) {
     ++same;
   }
   EXPECT_GT(same, 30u);  // the scans before the gap: identical
   EXPECT_LT(same, b.size());  // the gap: a scan ends where the dropped ones did not
-  for (const ScanRecord& r : b) {
-    EXPECT_NE(r.stamp_ns, a[same].stamp_ns) << "a dropped scan was processed";
+  for (const swarm::DroneOutput& r : b) {
+    EXPECT_NE(r.ego.stamp_ns, a[same].ego.stamp_ns) << "a dropped scan was processed";
   }
 
   ReplayOptions unknown;

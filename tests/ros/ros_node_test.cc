@@ -146,19 +146,19 @@ std::vector<Pose> ReadTum(const std::string& path) {
 
 // Max position difference of `poses` against `reference` paired by stamp
 // (within 1 us); counts the poses without a partner.
-double MaxDifference(const std::vector<Pose>& poses, const std::vector<replay::ScanRecord>& reference,
+double MaxDifference(const std::vector<Pose>& poses, const std::vector<swarm::DroneOutput>& reference,
                      int* unpaired) {
   double max_dp = 0.0;
   *unpaired = 0;
   for (const Pose& pose : poses) {
     const auto it = std::find_if(reference.begin(), reference.end(), [&](const auto& r) {
-      return std::abs(StampSeconds(r.stamp_ns) - pose.stamp_s) < 1e-6;
+      return std::abs(StampSeconds(r.ego.stamp_ns) - pose.stamp_s) < 1e-6;
     });
     if (it == reference.end()) {
       ++*unpaired;
       continue;
     }
-    max_dp = std::max(max_dp, (it->state.p_b_in_G - pose.p).norm());
+    max_dp = std::max(max_dp, (it->ego.state.p_b_in_G - pose.p).norm());
   }
   return max_dp;
 }
@@ -196,7 +196,7 @@ TEST_P(RosNodeTest, OdometryOverRosmasterEqualsOfflineReplay) {
   ASSERT_TRUE(s.ok()) << s.message();
   s = offline->Run(replay::ReplayOptions());
   ASSERT_TRUE(s.ok()) << s.message();
-  const std::vector<replay::ScanRecord>& reference = offline->drone(0).scans();
+  const std::vector<swarm::DroneOutput>& reference = offline->drone(0).scans();
   ASSERT_FALSE(reference.empty());
 
   // rosmaster on a free loopback port; every process talks over 127.0.0.1.
@@ -265,7 +265,7 @@ TEST_P(RosNodeTest, OdometryOverRosmasterEqualsOfflineReplay) {
   ASSERT_FALSE(written.empty());
   // Every scan of the replay, no more (a dropped scan is missing here).
   EXPECT_EQ(written.size(), reference.size());
-  EXPECT_GT(StampSeconds(reference.back().stamp_ns - reference.front().stamp_ns),
+  EXPECT_GT(StampSeconds(reference.back().ego.stamp_ns - reference.front().ego.stamp_ns),
             kDurationS - 2.0);
   int unpaired = 0;
   const double max_written_m = MaxDifference(written, reference, &unpaired);

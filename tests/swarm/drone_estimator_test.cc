@@ -193,6 +193,7 @@ TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) 
   EXPECT_GE(sink.extrinsic_messages_sent, (removed_at - identified_at) / 10);
   EXPECT_LE(sink.extrinsic_messages_sent, (removed_at - identified_at) / 10 + 2);
   EXPECT_EQ(estimator->counters().teammate_restarts, 1);
+  // The component's own test: its odometry's state layout (no driver reads it).
   EXPECT_TRUE(estimator->odometry().state().layout().teammate_ids().empty());
   EXPECT_NEAR(StampSeconds(sink.outputs[static_cast<size_t>(removed_at)].ego.stamp_ns) -
                   StampSeconds(sink.outputs.front().ego.stamp_ns),
@@ -295,12 +296,12 @@ TEST(DroneEstimator, IgnoresTeammatesExtrinsicsOfItsPreviousSession) {
   const int64_t t0 = 1'000'000'000'000;
   ImuSample imu;
   imu.linear_acceleration = Eigen::Vector3d(0, 0, 9.81);
-  for (int k = 0; k < 400 && !e->odometry().initialized(); ++k) {
+  for (int k = 0; k < 400 && !e->initialized(); ++k) {
     imu.stamp_ns = t0 + k * 5'000'000;
     ASSERT_TRUE(e->AddImu(imu).ok());
   }
-  ASSERT_TRUE(e->odometry().initialized());
-  const int64_t session_ns = e->odometry().initialization().stamp_ns;
+  ASSERT_TRUE(e->initialized());
+  const int64_t session_ns = e->initialization().stamp_ns;
   net::GlobalExtrinsicMessage g;
   g.sender_id = 1;
   net::GlobalExtrinsicEntry entry;

@@ -112,12 +112,6 @@ lio::OdometryOptions Options(const sim::DroneConfig& d, lio::EstimatorKind estim
   return options;
 }
 
-std::vector<replay::ScanRecord> Records(const std::vector<lio::ScanOutput>& outputs) {
-  std::vector<replay::ScanRecord> records;
-  for (const lio::ScanOutput& o : outputs) records.push_back(replay::ToScanRecord(o));
-  return records;
-}
-
 TEST(WindowOdometry, WindowOfOneReproducesTheFilter) {
   Simulation sim = Indoor(10.0);
   // uav1: Mid-360; uav3: Avia (IMU in g, 2 ms stamp offset).
@@ -191,7 +185,7 @@ TEST(WindowOdometry, WindowOfFiveTracksAShortIndoorFlight) {
   for (const size_t k : {size_t{0}, size_t{1}}) {
     const char* name = k == 0 ? "filter" : "window K = 5";
     SCOPED_TRACE(name);
-    const std::vector<replay::ScanRecord> scans = Records(sink.outputs[k]);
+    const std::vector<lio::ScanOutput>& scans = sink.outputs[k];
     ASSERT_GE(scans.size(), 50u);
     int updated = 0;
     for (const auto& s : scans) updated += s.updated ? 1 : 0;

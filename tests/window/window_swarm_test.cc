@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 
 // What one replay leaves of each drone.
 struct DroneRun {
-  std::vector<ScanRecord> scans;
+  std::vector<swarm::DroneOutput> scans;
   double position_rmse_m = 0.0;
   int identified = 0;
   int fused = 0;  // active + passive observations
@@ -71,7 +71,7 @@ class WindowSwarmTest : public ::testing::Test {
                       .ok());
       r.position_rmse_m = c.position_rmse_m;
       r.identified = static_cast<int>(d.identifications().size());
-      for (const ScanRecord& s : d.scans()) r.fused += s.active_observations + s.passive_observations;
+      for (const swarm::DroneOutput& s : d.scans()) r.fused += s.active_observations + s.passive_observations;
       out.push_back(std::move(r));
     }
     return out;
@@ -90,8 +90,8 @@ void ExtrinsicDifference(const DroneRun& a, const DroneRun& b, double* max_m, do
   *max_m = 0.0;
   *max_deg = 0.0;
   for (size_t k = 0; k < std::min(a.scans.size(), b.scans.size()); ++k) {
-    for (const TeammateRecord& ta : a.scans[k].teammates) {
-      for (const TeammateRecord& tb : b.scans[k].teammates) {
+    for (const swarm::TeammateEstimate& ta : a.scans[k].teammates) {
+      for (const swarm::TeammateEstimate& tb : b.scans[k].teammates) {
         if (ta.drone_id != tb.drone_id) continue;
         *max_m = std::max(*max_m, (ta.T_Gi_Gj.p_Gj_in_Gi - tb.T_Gi_Gj.p_Gj_in_Gi).norm());
         *max_deg = std::max(
@@ -130,7 +130,7 @@ TEST_F(WindowSwarmTest, WindowFusesTheTeammatesAndEqualsTheFilterAtOneState) {
     double max_dp = 0.0;
     for (size_t k = 0; k < filter[i].scans.size(); ++k) {
       max_dp = std::max(
-          max_dp, (filter[i].scans[k].state.p_b_in_G - one[i].scans[k].state.p_b_in_G).norm());
+          max_dp, (filter[i].scans[k].ego.state.p_b_in_G - one[i].scans[k].ego.state.p_b_in_G).norm());
     }
     double max_dT_m = 0.0, max_dT_deg = 0.0;
     ExtrinsicDifference(filter[i], one[i], &max_dT_m, &max_dT_deg);
@@ -154,11 +154,11 @@ TEST_F(WindowSwarmTest, WindowFusesTheTeammatesAndEqualsTheFilterAtOneState) {
     EXPECT_LT(five[i].position_rmse_m, 1.5 * filter[i].position_rmse_m + 0.002);
     EXPECT_LT(max_dT_m, 0.05);
     // Every teammate block has a covariance (the marginal of the window's information).
-    const ScanRecord& last = five[i].scans.back();
+    const swarm::DroneOutput& last = five[i].scans.back();
     ASSERT_EQ(last.teammates.size(), 2u);
-    for (const TeammateRecord& t : last.teammates) {
-      EXPECT_GT(t.extrinsic_sigma2.minCoeff(), 0.0);
-      EXPECT_TRUE(t.extrinsic_sigma2.allFinite());
+    for (const swarm::TeammateEstimate& t : last.teammates) {
+      EXPECT_GT(t.extrinsic_covariance.diagonal().minCoeff(), 0.0);
+      EXPECT_TRUE(t.extrinsic_covariance.diagonal().allFinite());
     }
   }
 }

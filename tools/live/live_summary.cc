@@ -84,7 +84,7 @@ std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& dr
                   static_cast<long long>(s.clock_start_ns), rate);
     text += line;
     std::snprintf(line, sizeof(line), "  odometry initialized at sensor stamp %lld ns (its G)\n",
-                  static_cast<long long>(drone.estimator().odometry().initialization().stamp_ns));
+                  static_cast<long long>(drone.estimator().initialization().stamp_ns));
     text += line;
     if (const net::ClockSync* sync = drone.estimator().clock_sync()) {
       text += net::FormatClockOffsets(*sync, s.sensor_end_ns, drone_names, "  ");

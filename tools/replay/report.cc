@@ -20,9 +20,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-eval::Trajectory EstimateTrajectory(const std::vector<replay::ScanRecord>& scans) {
+eval::Trajectory EstimateTrajectory(const std::vector<swarm::DroneOutput>& scans) {
   eval::Trajectory t;
-  for (const replay::ScanRecord& s : scans) {
+  for (const swarm::DroneOutput& o : scans) {
+    const lio::ScanOutput& s = o.ego;
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = s.state.q_G_b.normalized().toRotationMatrix();
     T.translation() = s.state.p_b_in_G;
@@ -32,7 +33,7 @@ eval::Trajectory EstimateTrajectory(const std::vector<replay::ScanRecord>& scans
   return t;
 }
 
-Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord>& scans) {
+Status WriteTiming(const std::string& path, const std::vector<swarm::DroneOutput>& scans) {
   std::ofstream out(path);
   if (!out) return Status::IoError(path + ": cannot open for writing");
   out << "stamp_s,updated,raw_points,points,correspondences,iterations,min_normal_information,"
@@ -40,7 +41,8 @@ Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord
          "covariance_ms,map_update_ms,total_ms,front_end_ms,active_fused,passive_fused,"
          "rejected_observations,extrinsics_frozen,build_ms,marginalize_ms\n";
   out << std::fixed;
-  for (const replay::ScanRecord& s : scans) {
+  for (const swarm::DroneOutput& o : scans) {
+    const lio::ScanOutput& s = o.ego;
     const lio::ScanTimings& t = s.timings;
     out << std::setprecision(9) << StampSeconds(s.stamp_ns) << "," << (s.updated ? 1 : 0) << ","
         << s.num_raw_points << "," << s.num_points << "," << s.num_correspondences << ","
@@ -49,8 +51,8 @@ Status WriteTiming(const std::string& path, const std::vector<replay::ScanRecord
         << 1e3 * t.preprocess_s << "," << 1e3 * t.propagate_s << "," << 1e3 * t.undistort_s << ","
         << 1e3 * t.association_s << "," << 1e3 * t.solve_s << "," << 1e3 * t.covariance_s << ","
         << 1e3 * t.map_update_s << "," << 1e3 * t.total_s << "," << 1e3 * t.front_end_s << ","
-        << s.active_observations << "," << s.passive_observations << ","
-        << s.rejected_observations << "," << (s.extrinsics_frozen ? 1 : 0) << ","
+        << o.active_observations << "," << o.passive_observations << ","
+        << o.rejected_observations << "," << (o.extrinsics_frozen ? 1 : 0) << ","
         << 1e3 * t.build_s << "," << 1e3 * t.marginalize_s << "\n";
   }
   return out ? Status::Ok() : Status::IoError(path + ": write failed");
@@ -106,20 +108,20 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
     note(eval::WriteTumTrajectory((dir / (name + "_tum.txt")).string(), estimate));
     note(WriteTiming((dir / (name + "_timing.csv")).string(), d.scans()));
     if (options.save_maps) {
-      note(io::WritePcd((dir / (name + "_map.pcd")).string(), d.odometry().MapPoints()));
+      note(io::WritePcd((dir / (name + "_map.pcd")).string(), d.estimator().MapPoints()));
     }
 
     eval::DroneMetrics m;
     m.drone = name;
     std::vector<double> total_ms;
     double busy_s = 0.0;
-    for (const auto& s : d.scans()) {
-      busy_s += s.timings.total_s;
-      if (s.updated) total_ms.push_back(1e3 * s.timings.total_s);
+    for (const swarm::DroneOutput& s : d.scans()) {
+      busy_s += s.ego.timings.total_s;
+      if (s.ego.updated) total_ms.push_back(1e3 * s.ego.timings.total_s);
     }
     const double log_s = d.scans().size() < 2 ? 0.0
-                                              : StampSeconds(d.scans().back().stamp_ns -
-                                                             d.scans().front().stamp_ns);
+                                              : StampSeconds(d.scans().back().ego.stamp_ns -
+                                                             d.scans().front().ego.stamp_ns);
     std::vector<std::pair<std::string, eval::MetricsValue>> extra = {{"scans", static_cast<double>(d.scans().size())},
                {"time_median_ms", eval::Percentile(total_ms, 0.5)},
                {"time_p95_ms", eval::Percentile(total_ms, 0.95)},

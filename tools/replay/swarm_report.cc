@@ -69,7 +69,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
     const std::string& name = d.input().name;
     const auto& scans = d.scans();
     if (scans.empty()) continue;
-    const double t0 = StampSeconds(scans.front().stamp_ns);
+    const double t0 = StampSeconds(scans.front().ego.stamp_ns);
     for (const swarm::IdentificationEvent& e : d.identifications()) {
       ident << name << "," << run.drone(e.drone_id).input().name << "," << std::fixed
             << std::setprecision(6) << StampSeconds(e.stamp_ns) << ","
@@ -81,15 +81,15 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
            "passive\n";
     std::map<int, eval::Trajectory> teammate_tum;
     std::map<int, PairMetrics> by_teammate;
-    for (const replay::ScanRecord& s : scans) {
-      const double t = StampSeconds(s.stamp_ns);
-      for (const replay::TeammateRecord& r : s.teammates) {
+    for (const swarm::DroneOutput& s : scans) {
+      const double t = StampSeconds(s.ego.stamp_ns);
+      for (const swarm::TeammateEstimate& r : s.teammates) {
         const Eigen::Quaterniond& q = r.T_Gi_Gj.q_Gi_Gj;
         const Eigen::Vector3d& p = r.T_Gi_Gj.p_Gj_in_Gi;
         ext << std::setprecision(9) << t << "," << run.drone(r.drone_id).input().name << ","
             << q.x() << "," << q.y() << "," << q.z() << "," << q.w() << "," << p.x() << ","
             << p.y() << "," << p.z();
-        for (int k = 0; k < 6; ++k) ext << "," << r.extrinsic_sigma2[k];
+        for (int k = 0; k < 6; ++k) ext << "," << r.extrinsic_covariance(k, k);
         ext << "," << r.active_observations << "," << r.passive_observations << "\n";
         PairMetrics& m = by_teammate[r.drone_id];
         m.active_fused += r.active_observations;
@@ -111,7 +111,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
         m.extrinsic_max_deg = std::max(m.extrinsic_max_deg, e_deg);
         // j's ground truth is stamped in j's clock: the same true instant.
         const driver::TrueClock& clock_j = run.drone(r.drone_id).input().true_clock;
-        const double t_j = StampSeconds(clock_j.ToDrone(d.input().true_clock.ToTrue(s.stamp_ns)));
+        const double t_j = StampSeconds(clock_j.ToDrone(d.input().true_clock.ToTrue(s.ego.stamp_ns)));
         Eigen::Isometry3d T_true_Gj_bj;
         if (r.have_pose && has_truth[r.drone_id] &&
             truth[r.drone_id].PoseAt(t_j, kMaxTruthGapS, &T_true_Gj_bj)) {
@@ -163,7 +163,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
       }
       if (m.relative_samples > 0) m.relative_rmse_m = std::sqrt(m.relative_rmse_m / m.relative_samples);
       // Clock offset of j as i estimated it at its last scan, against the truth.
-      const int64_t t_last = scans.back().stamp_ns;
+      const int64_t t_last = scans.back().ego.stamp_ns;
       m.clock_offset_true_ms =
           1e-6 * static_cast<double>(run.drone(j).input().true_clock.ToDrone(
                                          d.input().true_clock.ToTrue(t_last)) -
@@ -187,10 +187,10 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
   // Merged map: every drone's map in G of the first drone, through drone 0's
   // final T_G0_Gj estimates (drones it never identified are left out).
   if (save_maps && n > 0 && !run.drone(0).scans().empty()) {
-    std::vector<Eigen::Vector3d> merged = run.drone(0).odometry().MapPoints();
-    for (const replay::TeammateRecord& r : run.drone(0).scans().back().teammates) {
+    std::vector<Eigen::Vector3d> merged = run.drone(0).estimator().MapPoints();
+    for (const swarm::TeammateEstimate& r : run.drone(0).scans().back().teammates) {
       const Eigen::Isometry3d T = r.T_Gi_Gj.T_Gi_Gj();
-      for (const Eigen::Vector3d& p : run.drone(r.drone_id).odometry().MapPoints()) {
+      for (const Eigen::Vector3d& p : run.drone(r.drone_id).estimator().MapPoints()) {
         merged.push_back(T * p);
       }
     }

@@ -162,26 +162,27 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
   const auto& scans = d.scans();
   std::vector<double> total;
   int64_t updated = 0;
-  for (const auto& s : scans) {
-    if (!s.updated) continue;
-    total.push_back(1e3 * s.timings.total_s);
+  for (const swarm::DroneOutput& s : scans) {
+    if (!s.ego.updated) continue;
+    total.push_back(1e3 * s.ego.timings.total_s);
     ++updated;
   }
-  const lio::OdometryCounters& c = d.odometry().counters();
+  const swarm::DroneEstimator& e = d.estimator();
+  const lio::OdometryCounters& c = e.odometry_counters();
   std::printf("%s: %lld scans processed, %lld updated (%lld degenerate), %lld dropped before "
               "IMU init; map %zu points\n",
               d.input().name.c_str(), static_cast<long long>(c.scans_processed),
               static_cast<long long>(updated), static_cast<long long>(c.scans_degenerate),
-              static_cast<long long>(c.scans_before_init), d.odometry().map_size());
-  if (!d.odometry().initialized()) {
-    std::printf("  IMU never initialized: %s\n", d.odometry().initialization_error().c_str());
+              static_cast<long long>(c.scans_before_init), e.map_size());
+  if (!e.initialized()) {
+    std::printf("  IMU never initialized: %s\n", e.initialization_error().c_str());
   } else {
-    std::printf("  IMU init: %s\n", d.odometry().initialization().Summary().c_str());
+    std::printf("  IMU init: %s\n", e.initialization().Summary().c_str());
     std::printf("  odometry initialized at sensor stamp %lld ns\n",
-                static_cast<long long>(d.odometry().initialization().stamp_ns));
-    if (!d.odometry().initialization().sign_warning.empty()) {
+                static_cast<long long>(e.initialization().stamp_ns));
+    if (!e.initialization().sign_warning.empty()) {
       std::printf("  WARNING (IMU sign): %s\n",
-                  d.odometry().initialization().sign_warning.c_str());
+                  e.initialization().sign_warning.c_str());
     }
   }
   if (!total.empty()) {
@@ -212,17 +213,17 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
         continue;
       }
       std::vector<double> v;
-      for (const auto& s : scans) {
-        if (s.updated) v.push_back(1e3 * (s.timings.*st.field));
+      for (const swarm::DroneOutput& s : scans) {
+        if (s.ego.updated) v.push_back(1e3 * (s.ego.timings.*st.field));
       }
       std::printf(" %s %.2f", st.name, eval::Percentile(v, 0.5));
     }
     std::printf("\n");
   }
   if (scans.size() >= 2) {
-    const double log_s = StampSeconds(scans.back().stamp_ns - scans.front().stamp_ns);
+    const double log_s = StampSeconds(scans.back().ego.stamp_ns - scans.front().ego.stamp_ns);
     double busy_s = 0.0;
-    for (const auto& s : scans) busy_s += s.timings.total_s;
+    for (const swarm::DroneOutput& s : scans) busy_s += s.ego.timings.total_s;
     std::printf("  log %.1f s, estimator busy %.2f s: %.1fx real time (whole replay %.1f s wall)\n",
                 log_s, busy_s, busy_s > 0 ? log_s / busy_s : 0.0, wall_s);
   }
@@ -373,7 +374,7 @@ int Main() {
       std::printf("%s", swarm::FormatBroadcastCounters(c, "  ").c_str());
       if (const net::ClockSync* sync = run->drone(i).estimator().clock_sync()) {
         const auto& scans = run->drone(i).scans();
-        const int64_t now_ns = scans.empty() ? 0 : scans.back().stamp_ns;
+        const int64_t now_ns = scans.empty() ? 0 : scans.back().ego.stamp_ns;
         std::vector<std::string> names;
         for (int j = 0; j < run->num_drones(); ++j) names.push_back(run->drone(j).input().name);
         std::printf("%s", net::FormatClockOffsets(*sync, now_ns, names, "  ").c_str());

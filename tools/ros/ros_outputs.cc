@@ -152,7 +152,7 @@ void RosOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& la
     last_map_stamp_ns_ = o.ego.stamp_ns;
     if (map_.getNumSubscribers() > 0) {
       sensor_msgs::PointCloud2 cloud;
-      FillCloud(drone_->estimator().odometry().MapPoints(), options_.world_frame, o.ego.stamp_ns,
+      FillCloud(drone_->estimator().MapPoints(), options_.world_frame, o.ego.stamp_ns,
                 &cloud);
       map_.publish(cloud);
     }

@@ -2,8 +2,9 @@
 // reader and its driver::DroneDriver (the component); the replay loop asks
 // for the stamp of its next record and lets it consume that record (so N
 // drones interleave in stamp order).
-// It keeps per-scan results (bounded: a few hundred bytes a scan) and the
-// ground truth found in the bag.
+// It keeps the component's per-scan outputs, trimmed by KeptOutput (about
+// 3 kB a scan, most of it the ego covariance), and the ground truth found in
+// the bag.
 #pragma once
 
 #include <Eigen/Core>
@@ -23,51 +24,16 @@
 
 namespace swarmlio::replay {
 
-/// One teammate as an observer estimated it at one of its scan ends
-/// (compact: kept for every scan of every drone).
-struct TeammateRecord {
-  int drone_id = -1;  // index of the teammate in the manifest
-  GlobalExtrinsic T_Gi_Gj;
-  Eigen::Matrix<double, 6, 1> extrinsic_sigma2 = Eigen::Matrix<double, 6, 1>::Zero();  // cov diagonal
-  bool have_pose = false;
-  Eigen::Quaterniond q_Gi_bj = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d p_bj_in_Gi = Eigen::Vector3d::Zero();
-  bool seen = false;
-  int active_observations = 0;
-  int passive_observations = 0;
-};
-
-/// The per-scan record kept for evaluation and reports.
-struct ScanRecord {
-  int64_t stamp_ns = 0;  // state time (scan end)
-  EgoState state;
-  /// Covariance of [dtheta, dp] (rotation, position), ErrorStateLayout order.
-  Eigen::Matrix<double, 6, 6> pose_covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();
-  bool updated = false;
-  bool held_by_initialization = false;  // see lio::ScanOutput
-  int num_raw_points = 0;
-  int num_points = 0;
-  int num_correspondences = 0;
-  int iterations = 0;
-  double min_normal_information = 0.0;  // see lio::ScanOutput
-  bool degenerate = false;
-  size_t map_size = 0;
-  lio::ScanTimings timings;
-  std::vector<TeammateRecord> teammates;  // every teammate in the state
-  int active_observations = 0;
-  int passive_observations = 0;
-  int rejected_observations = 0;
-  bool extrinsics_frozen = false;
-};
-
-/// The record kept of one estimator output.
-ScanRecord ToScanRecord(const lio::ScanOutput& output);
-ScanRecord ToScanRecord(const swarm::DroneOutput& output);
+/// The output kept of each scan: the component's output without its large
+/// members (the registered scan, the error strings, the identifications,
+/// which identifications() keeps). See docs/architecture.md "The drivers'
+/// one loop".
+swarm::DroneOutput KeptOutput(swarm::DroneOutput output);
 
 /// The updated scans' poses with their position covariances (the estimate
 /// eval::EvaluateConsistency and eval::CheckGroundTruthFrame take).
-eval::CovariantTrajectory UpdatedEstimate(const std::vector<ScanRecord>& scans);
+eval::CovariantTrajectory UpdatedEstimate(const std::vector<lio::ScanOutput>& scans);
+eval::CovariantTrajectory UpdatedEstimate(const std::vector<swarm::DroneOutput>& scans);
 
 class DroneRunner : private driver::DriverSink {
  public:
@@ -103,9 +69,9 @@ class DroneRunner : private driver::DriverSink {
   }
 
   const driver::DroneInput& input() const { return input_; }
-  const std::vector<ScanRecord>& scans() const { return scans_; }
+  /// The outputs of the processed scans, trimmed by KeptOutput.
+  const std::vector<swarm::DroneOutput>& scans() const { return scans_; }
   const std::vector<PoseStamped>& bag_ground_truth() const { return ground_truth_; }
-  const lio::Odometry& odometry() const { return driver_->estimator().odometry(); }
   const swarm::DroneEstimator& estimator() const { return driver_->estimator(); }
   const io::BagReader& reader() const { return *reader_; }
   const driver::DroneWarnings& warnings() const { return driver_->warnings(); }
@@ -128,7 +94,7 @@ class DroneRunner : private driver::DriverSink {
   int64_t restart_ns_ = -1;  // pending restart: the log stamp (-1: none)
   std::vector<int64_t> skip_scan_stamps_ns_;  // sorted
   int64_t skipped_scans_ = 0;
-  std::vector<ScanRecord> scans_;
+  std::vector<swarm::DroneOutput> scans_;
   std::vector<net::SwarmMessage> outbox_;  // produced, not taken yet
   std::vector<swarm::IdentificationEvent> identifications_;
   std::vector<PoseStamped> ground_truth_;

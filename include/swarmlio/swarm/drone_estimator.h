@@ -155,7 +155,17 @@ class DroneEstimator {
   const net::ClockSync* clock_sync() const;
 
   int self_id() const { return self_id_; }
+  /// The component's own odometry (its unit tests); drivers use the
+  /// accessors below.
   const lio::Odometry& odometry() const { return *odometry_; }
+  /// What the drivers report of the odometry: its counters, the IMU
+  /// initialization (initialization() is valid once initialized()), the map.
+  const lio::OdometryCounters& odometry_counters() const { return odometry_->counters(); }
+  bool initialized() const { return odometry_->initialized(); }
+  const std::string& initialization_error() const { return odometry_->initialization_error(); }
+  const ImuInitialization& initialization() const { return odometry_->initialization(); }
+  size_t map_size() const { return odometry_->map_size(); }
+  std::vector<Eigen::Vector3d> MapPoints() const { return odometry_->MapPoints(); }
   const teammate::TeammateDetector& detector() const { return *detector_; }
   const DroneEstimatorCounters& counters() const { return counters_; }
   const DroneEstimatorOptions& options() const { return options_; }
