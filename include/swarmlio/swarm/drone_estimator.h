@@ -163,7 +163,7 @@ class DroneEstimator {
   const lio::OdometryCounters& odometry_counters() const { return odometry_->counters(); }
   bool initialized() const { return odometry_->initialized(); }
   const std::string& initialization_error() const { return odometry_->initialization_error(); }
-  const ImuInitialization& initialization() const { return odometry_->initialization(); }
+  const lio::ImuInitialization& initialization() const { return odometry_->initialization(); }
   size_t map_size() const { return odometry_->map_size(); }
   std::vector<Eigen::Vector3d> MapPoints() const { return odometry_->MapPoints(); }
   const teammate::TeammateDetector& detector() const { return *detector_; }
