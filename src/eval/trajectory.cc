@@ -57,7 +57,7 @@ Trajectory TrajectoryFromPoses(const std::vector<PoseStamped>& poses) {
     Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
     T_G_b.linear() = pose.q_G_b.normalized().toRotationMatrix();
     T_G_b.translation() = pose.p_b_in_G;
-    out.stamps_s.push_back(StampSeconds(pose.stamp_ns));
+    out.stamps_s.push_back(ToSeconds(pose.stamp_ns));
     out.T_G_b.push_back(T_G_b);
   }
   return out;

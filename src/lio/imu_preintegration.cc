@@ -118,7 +118,7 @@ void ImuPreintegration::Integrate(const Step& step) {
 }
 
 void ImuPreintegration::Advance(const ImuInput& u, int64_t stamp_ns) {
-  const Step step{u, StampSeconds(stamp_ns - stamp_ns_)};
+  const Step step{u, ToSeconds(stamp_ns - stamp_ns_)};
   Integrate(step);
   steps_.push_back(step);
   stamp_ns_ = stamp_ns;
@@ -127,7 +127,7 @@ void ImuPreintegration::Advance(const ImuInput& u, int64_t stamp_ns) {
 
 void ImuPreintegration::Publish() {
   PreintegratedImu& m = preintegrated_;
-  m.dt_s = StampSeconds(stamp_ns_ - start_stamp_ns_);
+  m.dt_s = ToSeconds(stamp_ns_ - start_stamp_ns_);
   m.delta_R = delta_.R_G_b();
   m.delta_v = delta_.v_b_in_G;
   m.delta_p = delta_.p_b_in_G;
@@ -149,7 +149,7 @@ void ImuPreintegration::Publish() {
 }
 
 Status ImuPreintegration::CheckGap(int64_t stamp_ns) const {
-  const double dt = StampSeconds(stamp_ns - stamp_ns_);
+  const double dt = ToSeconds(stamp_ns - stamp_ns_);
   if (dt <= options_.max_gap_s) return Status::Ok();
   std::ostringstream os;
   os << "imu preintegration: gap of " << dt << " s from " << stamp_ns_ << " ns to " << stamp_ns

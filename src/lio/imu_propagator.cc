@@ -158,7 +158,7 @@ Status ImuPropagator::Reset(const ImuInitialization& init) {
 }
 
 Status ImuPropagator::CheckGap(int64_t stamp_ns) const {
-  const double dt = StampSeconds(stamp_ns - stamp_ns_);
+  const double dt = ToSeconds(stamp_ns - stamp_ns_);
   if (dt <= options_.max_gap_s) return Status::Ok();
   std::ostringstream os;
   os << "imu propagator: gap of " << dt << " s from " << stamp_ns_ << " ns to " << stamp_ns
@@ -200,7 +200,7 @@ Status ImuPropagator::AddImu(const ImuSample& sample) {
   // between the previous sample and this one (the plain mean of the two when
   // the state sits on the previous sample).
   const ImuInput mid = MidpointInput(u, sample.stamp_ns, sample.stamp_ns);
-  Step(mid, StampSeconds(sample.stamp_ns - stamp_ns_), sample.stamp_ns);
+  Step(mid, ToSeconds(sample.stamp_ns - stamp_ns_), sample.stamp_ns);
   last_input_ = u;
   last_sample_stamp_ns_ = sample.stamp_ns;
   last_sample_ = sample;
@@ -235,15 +235,15 @@ Status ImuPropagator::PropagateTo(int64_t stamp_ns, const ImuSample* next_sample
     ++num_gaps_;
     return gap;
   }
-  Step(u, StampSeconds(stamp_ns - stamp_ns_), stamp_ns);
+  Step(u, ToSeconds(stamp_ns - stamp_ns_), stamp_ns);
   return Status::Ok();
 }
 
 ImuInput MidpointInput(const ImuInput& last, int64_t last_stamp_ns, const ImuInput& next,
                        int64_t next_stamp_ns, int64_t from_ns, int64_t to_ns) {
-  const double span_s = StampSeconds(next_stamp_ns - last_stamp_ns);
+  const double span_s = ToSeconds(next_stamp_ns - last_stamp_ns);
   const double t_mid_s =
-      0.5 * (StampSeconds(from_ns - last_stamp_ns) + StampSeconds(to_ns - last_stamp_ns));
+      0.5 * (ToSeconds(from_ns - last_stamp_ns) + ToSeconds(to_ns - last_stamp_ns));
   const double alpha = span_s > 0.0 ? t_mid_s / span_s : 0.0;
   ImuInput mid;
   mid.angular_velocity_rad_s =

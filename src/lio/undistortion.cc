@@ -29,7 +29,7 @@ void PoseInInterval(const ImuPose& pose,
 std::vector<double> RelativeTimes(const std::vector<ImuPose>& poses) {
   std::vector<double> times_s(poses.size());
   for (size_t i = 0; i < poses.size(); ++i) {
-    times_s[i] = StampSeconds(poses[i].stamp_ns - poses.front().stamp_ns);
+    times_s[i] = ToSeconds(poses[i].stamp_ns - poses.front().stamp_ns);
   }
   return times_s;
 }
@@ -43,7 +43,7 @@ void BodyPoseAt(const std::vector<ImuPose>& poses,
                 Eigen::Vector3d* p_b_in_G) {
   CHECK(!poses.empty());
   const std::vector<double> times_s = RelativeTimes(poses);
-  const double t_s = StampSeconds(stamp_ns - poses.front().stamp_ns) + offset_s;
+  const double t_s = ToSeconds(stamp_ns - poses.front().stamp_ns) + offset_s;
   const int i = IntervalIndex(times_s, t_s);
   PoseInInterval(poses[i], t_s - times_s[i], R_G_b, p_b_in_G);
 }
@@ -74,7 +74,7 @@ UndistortionStats UndistortImpl(size_t num_points, int64_t scan_stamp_ns,
   const ImuPose& end = poses.back();
   stats.end_stamp_ns = end.stamp_ns;
   const std::vector<double> times_s = RelativeTimes(poses);
-  const double scan_start_s = StampSeconds(scan_stamp_ns - poses.front().stamp_ns);
+  const double scan_start_s = ToSeconds(scan_stamp_ns - poses.front().stamp_ns);
   const double last_s = times_s.back();
   const Eigen::Matrix3d R_e_T = end.R_G_b.transpose();
   for (size_t k = 0; k < num_points; ++k) {

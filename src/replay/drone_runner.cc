@@ -53,7 +53,7 @@ void AppendIfUpdated(const lio::ScanOutput& s, eval::CovariantTrajectory* out) {
   Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
   T_G_b.linear() = s.state.q_G_b.normalized().toRotationMatrix();
   T_G_b.translation() = s.state.p_b_in_G;
-  out->poses.stamps_s.push_back(StampSeconds(s.stamp_ns));
+  out->poses.stamps_s.push_back(ToSeconds(s.stamp_ns));
   out->poses.T_G_b.push_back(T_G_b);
   out->position_covariances.push_back(
       s.covariance.block<3, 3>(ErrorStateLayout::kPosition.offset, ErrorStateLayout::kPosition.offset));

@@ -143,7 +143,7 @@ Status Simulator::RunDrone(int drone, DroneSink* sink, DroneStats* stats) const 
       out.z = static_cast<float>(p.p_in_lidar.z());
       out.reflectivity = static_cast<float>(p.reflectivity);
       // The sensor reports integer nanoseconds: quantise like the log will.
-      out.offset_time_s = StampSeconds(StampNs(drone, p.t_s) - scan.stamp_ns);
+      out.offset_time_s = ToSeconds(StampNs(drone, p.t_s) - scan.stamp_ns);
       out.tag = p.tag;  // Livox: return number (0x10 first), normal point
       out.line = p.line;
       if (p.object >= 0 && p.object < static_cast<int>(drones_.size())) {

@@ -49,7 +49,7 @@ TEST(BagGroundTruth, ReadsThePoses) {
   ASSERT_TRUE(status.ok()) << status.message();
   ASSERT_EQ(trajectory.size(), 6u);
   for (int i = 0; i < 6; ++i) {
-    EXPECT_EQ(trajectory.stamps_s[i], StampSeconds(2000000000 + i * 10000000LL + 7));
+    EXPECT_EQ(trajectory.stamps_s[i], ToSeconds(2000000000 + i * 10000000LL + 7));
     EXPECT_EQ(trajectory.T_G_b[i].translation(), Eigen::Vector3d(0.5 * i, -0.25 * i, 1.0));
     EXPECT_NEAR(Eigen::AngleAxisd(trajectory.T_G_b[i].linear()).angle(), 0.1 * i, 1e-12);
   }
@@ -70,7 +70,7 @@ TEST(BagGroundTruth, ReadsOdometryOnOtherTopics) {
   const Status status = ReadBagGroundTruth(path, options, &trajectory);
   ASSERT_TRUE(status.ok()) << status.message();
   ASSERT_EQ(trajectory.size(), 5u);
-  EXPECT_EQ(trajectory.stamps_s[4], StampSeconds(2000000000 + 4 * 10000000LL + 7));
+  EXPECT_EQ(trajectory.stamps_s[4], ToSeconds(2000000000 + 4 * 10000000LL + 7));
   EXPECT_EQ(trajectory.T_G_b[4].translation(), Eigen::Vector3d(2.0, -1.0, 1.0));
 }
 

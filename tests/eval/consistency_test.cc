@@ -25,7 +25,7 @@ void AddPose(int64_t stamp_ns,
   Eigen::Isometry3d T_G_b = Eigen::Isometry3d::Identity();
   T_G_b.linear() = q_G_b.normalized().toRotationMatrix();
   T_G_b.translation() = p_b_in_G;
-  estimate->poses.stamps_s.push_back(StampSeconds(stamp_ns));
+  estimate->poses.stamps_s.push_back(ToSeconds(stamp_ns));
   estimate->poses.T_G_b.push_back(T_G_b);
   estimate->position_covariances.push_back(P_pp);
 }

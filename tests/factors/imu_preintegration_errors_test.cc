@@ -66,7 +66,7 @@ TEST(ImuPreintegration, HandlesSamplesLikeThePropagator) {
   ASSERT_TRUE(pre->AddImu(at_target).ok());
   EXPECT_EQ(pre->num_intervals(), 3);
   EXPECT_EQ(pre->num_skipped_out_of_order(), 1);
-  EXPECT_EQ(pre->preintegrated().dt_s, StampSeconds(3 * kImuPeriodNs));
+  EXPECT_EQ(pre->preintegrated().dt_s, ToSeconds(3 * kImuPeriodNs));
 }
 
 TEST(ImuPreintegrationFactor, CreateRejectsUnusableMeasurements) {

@@ -30,10 +30,10 @@ TEST(ImuPreintegrationFactor, ResidualIsZeroWhereThePropagatorLands) {
       const Window& w = windows[i];
       const FilterRun run = RunPropagator(m, w, 1e-4 * Eigen::MatrixXd::Identity(18, 18));
       // The propagator follows the motion closely (sanity), ...
-      EXPECT_LT(run.x_k1.BoxMinus(m.State(StampSeconds(w.t_k1_ns))).norm(), 1e-3);
+      EXPECT_LT(run.x_k1.BoxMinus(m.State(ToSeconds(w.t_k1_ns))).norm(), 1e-3);
       // ... and the preintegration agrees with it to round-off.
       const auto pre = Preintegrate(m, w, run.x_k.gyro_bias, run.x_k.accel_bias);
-      EXPECT_EQ(pre->preintegrated().dt_s, StampSeconds(w.t_k1_ns - w.t_k_ns));
+      EXPECT_EQ(pre->preintegrated().dt_s, ToSeconds(w.t_k1_ns - w.t_k_ns));
       const auto factor = MakeFactor(pre->preintegrated());
       const Vector18 e = factor->Error(run.x_k, run.x_k1);
       const Vector18 r = factor->Residual(run.x_k, run.x_k1);
@@ -95,7 +95,7 @@ TEST(ImuPreintegration, CovarianceIsThePropagatorsFromZero) {
     SCOPED_TRACE(identity_attitude ? "R_k = I" : "random R_k");
     const Motion m(&s);
     const Window w;
-    EgoState x_k = m.State(StampSeconds(w.t_k_ns));
+    EgoState x_k = m.State(ToSeconds(w.t_k_ns));
     if (identity_attitude) x_k.q_G_b.setIdentity();
     const FilterRun run = RunPropagator(m, w, Eigen::MatrixXd::Zero(18, 18), &x_k);
     const auto pre = Preintegrate(m, w, x_k.gyro_bias, x_k.accel_bias);
@@ -181,7 +181,7 @@ TEST(ImuPreintegration, BiasCorrectionIsFirstOrderAccurate) {
     }
     previous_error = error;
     // The factor at states with these biases: corrected vs re-preintegrated.
-    EgoState x_k = m.State(StampSeconds(w.t_k_ns));
+    EgoState x_k = m.State(ToSeconds(w.t_k_ns));
     x_k.gyro_bias = bg;
     x_k.accel_bias = ba;
     const EgoState x_k1 = Predict(again, x_k);

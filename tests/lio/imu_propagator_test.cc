@@ -124,7 +124,7 @@ TEST(ImuPropagator, NoiseFreeHelixIsReproduced) {
           .ok());
   const int steps = 400;  // 2 s at 200 Hz
   for (int k = 1; k <= steps; ++k) ASSERT_TRUE(prop->AddImu(helix.Sample(k * kImuPeriodNs)).ok());
-  const double t = StampSeconds(steps * kImuPeriodNs);
+  const double t = ToSeconds(steps * kImuPeriodNs);
   ASSERT_EQ(prop->stamp_ns(), steps * kImuPeriodNs);
   const Vec e = prop->state().ego.BoxMinus(helix.State(t));
   const double pos_err = e.segment<3>(L::kPosition.offset).norm();
@@ -158,10 +158,10 @@ TEST(ImuPropagator, PropagatesToExactlyATimeBetweenSamples) {
   EXPECT_LT(prop->state().ego.BoxMinus(expected).norm(), 1e-12);
   // The hold of the last sample is first order over the 3.2 ms remainder:
   // |dv| ~ |jerk| tau^2 / 2 ~ 5e-5 m/s on this helix.
-  EXPECT_LT(prop->state().ego.BoxMinus(helix.State(StampSeconds(end_ns))).norm(), 1e-4);
+  EXPECT_LT(prop->state().ego.BoxMinus(helix.State(ToSeconds(end_ns))).norm(), 1e-4);
   // Continuing from there with the next sample stays on the trajectory.
   ASSERT_TRUE(prop->AddImu(helix.Sample(21 * kImuPeriodNs)).ok());
-  EXPECT_LT(prop->state().ego.BoxMinus(helix.State(StampSeconds(21 * kImuPeriodNs))).norm(), 1e-4);
+  EXPECT_LT(prop->state().ego.BoxMinus(helix.State(ToSeconds(21 * kImuPeriodNs))).norm(), 1e-4);
   EXPECT_TRUE(prop->PropagateTo(21 * kImuPeriodNs).ok());  // same time: no-op
   EXPECT_EQ(prop->PropagateTo(20 * kImuPeriodNs).code(), Status::Code::kOutOfRange);
 }
@@ -180,12 +180,12 @@ TEST(ImuPropagator, PropagateToWithTheNextSampleIsSecondOrder) {
   EXPECT_EQ(prop->PropagateTo(end_ns, &early).code(), Status::Code::kInvalidArgument);
   ASSERT_TRUE(prop->PropagateTo(end_ns, &next).ok());
   EXPECT_EQ(prop->stamp_ns(), end_ns);
-  const double err = prop->state().ego.BoxMinus(helix.State(StampSeconds(end_ns))).norm();
+  const double err = prop->state().ego.BoxMinus(helix.State(ToSeconds(end_ns))).norm();
   std::printf("[ figures  ] propagate 3.217 ms past a sample: error %.2e with the next sample\n",
               err);
   EXPECT_LT(err, 1e-5);
   ASSERT_TRUE(prop->AddImu(next).ok());
-  EXPECT_LT(prop->state().ego.BoxMinus(helix.State(StampSeconds(21 * kImuPeriodNs))).norm(), 1e-5);
+  EXPECT_LT(prop->state().ego.BoxMinus(helix.State(ToSeconds(21 * kImuPeriodNs))).norm(), 1e-5);
 }
 
 TEST(ImuPropagator, SampleAtAReachedTargetBecomesTheInput) {
@@ -378,7 +378,7 @@ TEST(ImuPropagator, MonteCarloErrorMatchesCovariance) {
   const Eigen::MatrixXd L0 = P0.llt().matrixL();
   const Eigen::VectorXd q_std = EgoNoiseCovariance(options.process_noise).diagonal().cwiseSqrt();
   const int runs = 300;
-  const double dt = StampSeconds(kImuPeriodNs);
+  const double dt = ToSeconds(kImuPeriodNs);
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(18, 18);
   const Eigen::MatrixXd P_inv = P.inverse();
   double nees_sum = 0.0;

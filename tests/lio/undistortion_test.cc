@@ -36,7 +36,7 @@ std::vector<ImuPose> PropagatedPoses(const Helix& helix) {
   int64_t k = (kScanStartNs - kImuPhaseNs) / kImuPeriodNs;
   const int64_t first_ns = k * kImuPeriodNs + kImuPhaseNs;
   SwarmState x0;
-  x0.ego = helix.State(StampSeconds(first_ns));
+  x0.ego = helix.State(ToSeconds(first_ns));
   EXPECT_TRUE(
       prop->Reset(x0, 1e-6 * Eigen::MatrixXd::Identity(18, 18), helix.Sample(first_ns), 1.0).ok());
   for (++k; k * kImuPeriodNs + kImuPhaseNs <= kScanEndNs; ++k) {
@@ -53,7 +53,7 @@ LidarScan SyntheticScan(const Helix& helix,
                         int n,
                         std::mt19937& rng,
                         std::vector<Eigen::Vector3d>* world_points) {
-  std::uniform_real_distribution<double> time_s(0.0, StampSeconds(kScanEndNs - kScanStartNs));
+  std::uniform_real_distribution<double> time_s(0.0, ToSeconds(kScanEndNs - kScanStartNs));
   std::uniform_real_distribution<double> range_m(5.0, 20.0);
   std::normal_distribution<double> dir;
   LidarScan scan;
@@ -61,7 +61,7 @@ LidarScan SyntheticScan(const Helix& helix,
   world_points->clear();
   for (int i = 0; i < n; ++i) {
     const double dt = time_s(rng);
-    const double t = StampSeconds(kScanStartNs) + dt;
+    const double t = ToSeconds(kScanStartNs) + dt;
     const Eigen::Matrix3d R_W_L = helix.R(t) * ext.R_imu_lidar;
     const Eigen::Vector3d p_L_in_W = helix.p(t) + helix.R(t) * ext.p_lidar_in_imu;
     const Eigen::Vector3d ray = Eigen::Vector3d(dir(rng), dir(rng), dir(rng)).normalized();
@@ -98,7 +98,7 @@ TEST(Undistortion, PointsReturnToTheirWorldPositions) {
   EXPECT_EQ(stats.num_extrapolated, 0);
   EXPECT_EQ(stats.end_stamp_ns, kScanEndNs);
 
-  const double t_end = StampSeconds(kScanEndNs);
+  const double t_end = ToSeconds(kScanEndNs);
   const Eigen::Matrix3d R_end = helix.R(t_end);
   const Eigen::Vector3d p_end = helix.p(t_end);
   double max_err = 0.0, max_err_raw = 0.0;
@@ -168,7 +168,7 @@ TEST(Undistortion, BodyPoseAtMatchesThePosesAtTheirStamps) {
   for (size_t i = 0; i + 1 < poses.size(); ++i) {
     Eigen::Matrix3d R;
     Eigen::Vector3d p;
-    const double dt = StampSeconds(poses[i + 1].stamp_ns - poses[i].stamp_ns);
+    const double dt = ToSeconds(poses[i + 1].stamp_ns - poses[i].stamp_ns);
     const std::vector<ImuPose> one{poses[i]};
     BodyPoseAt(one, poses[i].stamp_ns, dt, &R, &p);
     EXPECT_LT((p - poses[i + 1].p_b_in_G).norm(), 1e-12);

@@ -152,7 +152,7 @@ double MaxDifference(const std::vector<Pose>& poses, const std::vector<swarm::Dr
   *unpaired = 0;
   for (const Pose& pose : poses) {
     const auto it = std::find_if(reference.begin(), reference.end(), [&](const auto& r) {
-      return std::abs(StampSeconds(r.ego.stamp_ns) - pose.stamp_s) < 1e-6;
+      return std::abs(ToSeconds(r.ego.stamp_ns) - pose.stamp_s) < 1e-6;
     });
     if (it == reference.end()) {
       ++*unpaired;
@@ -226,7 +226,7 @@ TEST_P(RosNodeTest, OdometryOverRosmasterEqualsOfflineReplay) {
     ros::Subscriber subscriber = node.subscribe<nav_msgs::Odometry>(
         "/swarmlio_ros/odometry", 1000, [&](const nav_msgs::Odometry::ConstPtr& m) {
           Pose pose;
-          pose.stamp_s = StampSeconds(static_cast<int64_t>(m->header.stamp.toNSec()));
+          pose.stamp_s = ToSeconds(static_cast<int64_t>(m->header.stamp.toNSec()));
           pose.p = {m->pose.pose.position.x, m->pose.pose.position.y, m->pose.pose.position.z};
           std::lock_guard<std::mutex> lock(mutex);
           received.push_back(pose);
@@ -265,7 +265,7 @@ TEST_P(RosNodeTest, OdometryOverRosmasterEqualsOfflineReplay) {
   ASSERT_FALSE(written.empty());
   // Every scan of the replay, no more (a dropped scan is missing here).
   EXPECT_EQ(written.size(), reference.size());
-  EXPECT_GT(StampSeconds(reference.back().ego.stamp_ns - reference.front().ego.stamp_ns),
+  EXPECT_GT(ToSeconds(reference.back().ego.stamp_ns - reference.front().ego.stamp_ns),
             kDurationS - 2.0);
   int unpaired = 0;
   const double max_written_m = MaxDifference(written, reference, &unpaired);

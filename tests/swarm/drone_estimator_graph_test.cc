@@ -97,7 +97,7 @@ TEST(DroneEstimator, ReidentifiesARestartedTeammateThroughAGraphDerivedTeammate)
   EXPECT_EQ(r.via, 2);
   // Drone 2's first entry of the new session is taken max_message_age_s
   // (0.5 s) after the new session was heard (11.52 s), so from 12.5 s on.
-  const double after_s = StampSeconds(r.reidentified_ns) - StampSeconds(r.restart_removed_ns);
+  const double after_s = ToSeconds(r.reidentified_ns) - ToSeconds(r.restart_removed_ns);
   std::printf("[ figures  ] re-identified %.2f s after the removal, T_G0_G1 error %.4f m %.3f deg "
               "(1-sigma >= %.4f m)\n", after_s, r.error_m, r.error_deg, r.sigma_p_m);
   EXPECT_LT(after_s, 1.5);
@@ -126,7 +126,7 @@ TEST(DroneEstimator, ReidentifiesARestartedTeammateThroughTheInverseOfADerivedEn
   ASSERT_GE(r.reidentified_ns, 0) << "the restarted teammate was never identified again";
   EXPECT_EQ(r.method, "graph");
   EXPECT_EQ(r.via, 2);
-  const double after_s = StampSeconds(r.reidentified_ns) - StampSeconds(r.restart_removed_ns);
+  const double after_s = ToSeconds(r.reidentified_ns) - ToSeconds(r.restart_removed_ns);
   std::printf("[ figures  ] re-identified %.2f s after the removal, T_G0_G1 error %.4f m %.3f deg\n",
               after_s, r.error_m, r.error_deg);
   EXPECT_LT(after_s, 1.5);

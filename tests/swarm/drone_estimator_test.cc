@@ -195,9 +195,9 @@ TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) 
   EXPECT_EQ(estimator->counters().teammate_restarts, 1);
   // The component's own test: its odometry's state layout (no driver reads it).
   EXPECT_TRUE(estimator->odometry().state().layout().teammate_ids().empty());
-  EXPECT_NEAR(StampSeconds(sink.outputs[static_cast<size_t>(removed_at)].ego.stamp_ns) -
-                  StampSeconds(sink.outputs.front().ego.stamp_ns),
-              21.0 - StampSeconds(sink.outputs.front().ego.stamp_ns - simulator.StampNs(observer, 0.0)),
+  EXPECT_NEAR(ToSeconds(sink.outputs[static_cast<size_t>(removed_at)].ego.stamp_ns) -
+                  ToSeconds(sink.outputs.front().ego.stamp_ns),
+              21.0 - ToSeconds(sink.outputs.front().ego.stamp_ns - simulator.StampNs(observer, 0.0)),
               0.25);
 
   // T_Gi_Gj just before the reboot against the truth.
@@ -258,7 +258,7 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
   for (const DroneOutput& o : sink.outputs) {
     for (const IdentificationEvent& e : o.identifications) {
       if (identified_s < 0.0) {
-        identified_s = StampSeconds(e.stamp_ns) - StampSeconds(simulator.StampNs(observer, 0.0));
+        identified_s = ToSeconds(e.stamp_ns) - ToSeconds(simulator.StampNs(observer, 0.0));
         method = e.method;
       }
     }

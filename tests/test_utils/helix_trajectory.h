@@ -61,7 +61,7 @@ struct Helix {
     return x;
   }
   ImuSample Sample(int64_t stamp_ns) const {
-    const double t = StampSeconds(stamp_ns);
+    const double t = ToSeconds(stamp_ns);
     ImuSample s;
     s.stamp_ns = stamp_ns;
     s.angular_velocity_rad_s = w_b(t);

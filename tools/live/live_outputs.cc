@@ -71,12 +71,12 @@ std::string LiveOutputs::DroneName(int id) const {
 
 void LiveOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& latency) {
   const EgoState& x = o.ego.state;
-  const double t_s = StampSeconds(o.ego.stamp_ns);
+  const double t_s = ToSeconds(o.ego.stamp_ns);
   if (first_scan_s_ < 0.0) first_scan_s_ = t_s;
   for (const swarm::IdentificationEvent& e : o.identifications) {
     Check(std::fprintf(identifications_, "%s,%s,%.6f,%.6f,%s,%.6g\n", name_.c_str(),
-                       DroneName(e.drone_id).c_str(), StampSeconds(e.stamp_ns),
-                       StampSeconds(e.stamp_ns) - first_scan_s_, e.method.c_str(),
+                       DroneName(e.drone_id).c_str(), ToSeconds(e.stamp_ns),
+                       ToSeconds(e.stamp_ns) - first_scan_s_, e.method.c_str(),
                        e.mean_residual_m) > 0,
           identifications_path_);
   }
@@ -109,7 +109,7 @@ void LiveOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& l
 
 void LiveOutputs::OnScanDropped(int64_t scan_stamp_ns, live::ScanDropReason reason) {
   const char* why = reason == live::ScanDropReason::kQueueFull ? "queue" : "backlog";
-  Check(std::fprintf(timing_, "%.9f,%s,,,,,,,,,,,,\n", StampSeconds(scan_stamp_ns), why) > 0,
+  Check(std::fprintf(timing_, "%.9f,%s,,,,,,,,,,,,\n", ToSeconds(scan_stamp_ns), why) > 0,
         timing_path_);
   // Flushed at once: a re-run of a crashed process still leaves these out.
   Check(std::fprintf(dropped_, "%lld %s\n", static_cast<long long>(scan_stamp_ns), why) > 0 &&
@@ -121,7 +121,7 @@ void LiveOutputs::OnImuPose(const live::ImuRatePose& p) {
   if (imu_ == nullptr) return;
   const Eigen::Vector3d& w = p.angular_velocity_in_b_rad_s;
   Check(std::fprintf(imu_, "%.9f,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f\n",
-                     StampSeconds(p.stamp_ns), p.p_b_in_G.x(), p.p_b_in_G.y(), p.p_b_in_G.z(),
+                     ToSeconds(p.stamp_ns), p.p_b_in_G.x(), p.p_b_in_G.y(), p.p_b_in_G.z(),
                      p.q_G_b.x(), p.q_G_b.y(), p.q_G_b.z(), p.q_G_b.w(), p.v_b_in_G.x(),
                      p.v_b_in_G.y(), p.v_b_in_G.z(), w.x(), w.y(), w.z()) > 0,
         imu_path_);

@@ -15,12 +15,12 @@ std::string FormatLiveSummary(const std::string& name, const live::LiveDrone& dr
   std::vector<double> latency;
   // From the drone's own counters: the ROS node without --output_dir has no
   // LiveOutputs and used to print 0 Hz.
-  const double imu_span_s = StampSeconds(s.last_imu_pose_ns - s.first_imu_pose_ns);
+  const double imu_span_s = ToSeconds(s.last_imu_pose_ns - s.first_imu_pose_ns);
   if (outputs != nullptr) {
     latency.assign(outputs->latencies_ms().begin(), outputs->latencies_ms().end());
   }
   if (latencies_ms != nullptr) latency.assign(latencies_ms->begin(), latencies_ms->end());
-  const double played_s = StampSeconds(s.sensor_end_ns - s.sensor_start_ns);
+  const double played_s = ToSeconds(s.sensor_end_ns - s.sensor_start_ns);
   const std::string held =
       s.scans_held_by_initialization > 0
           ? " (not counted: " + std::to_string(s.scans_held_by_initialization) +

@@ -27,7 +27,7 @@ eval::Trajectory EstimateTrajectory(const std::vector<swarm::DroneOutput>& scans
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = s.state.q_G_b.normalized().toRotationMatrix();
     T.translation() = s.state.p_b_in_G;
-    t.stamps_s.push_back(StampSeconds(s.stamp_ns));
+    t.stamps_s.push_back(ToSeconds(s.stamp_ns));
     t.T_G_b.push_back(T);
   }
   return t;
@@ -44,7 +44,7 @@ Status WriteTiming(const std::string& path, const std::vector<swarm::DroneOutput
   for (const swarm::DroneOutput& o : scans) {
     const lio::ScanOutput& s = o.ego;
     const lio::ScanTimings& t = s.timings;
-    out << std::setprecision(9) << StampSeconds(s.stamp_ns) << "," << (s.updated ? 1 : 0) << ","
+    out << std::setprecision(9) << ToSeconds(s.stamp_ns) << "," << (s.updated ? 1 : 0) << ","
         << s.num_raw_points << "," << s.num_points << "," << s.num_correspondences << ","
         << s.iterations << "," << std::setprecision(2) << s.min_normal_information << ","
         << (s.degenerate ? 1 : 0) << "," << s.map_size << std::setprecision(4) << ","
@@ -120,7 +120,7 @@ Status WriteReport(const replay::SwarmReplay& run, const ReportOptions& options,
       if (s.ego.updated) total_ms.push_back(1e3 * s.ego.timings.total_s);
     }
     const double log_s = d.scans().size() < 2 ? 0.0
-                                              : StampSeconds(d.scans().back().ego.stamp_ns -
+                                              : ToSeconds(d.scans().back().ego.stamp_ns -
                                                              d.scans().front().ego.stamp_ns);
     std::vector<std::pair<std::string, eval::MetricsValue>> extra = {{"scans", static_cast<double>(d.scans().size())},
                {"time_median_ms", eval::Percentile(total_ms, 0.5)},

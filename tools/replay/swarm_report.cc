@@ -69,11 +69,11 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
     const std::string& name = d.input().name;
     const auto& scans = d.scans();
     if (scans.empty()) continue;
-    const double t0 = StampSeconds(scans.front().ego.stamp_ns);
+    const double t0 = ToSeconds(scans.front().ego.stamp_ns);
     for (const swarm::IdentificationEvent& e : d.identifications()) {
       ident << name << "," << run.drone(e.drone_id).input().name << "," << std::fixed
-            << std::setprecision(6) << StampSeconds(e.stamp_ns) << ","
-            << StampSeconds(e.stamp_ns) - t0 << "," << e.method << "," << e.mean_residual_m << "\n";
+            << std::setprecision(6) << ToSeconds(e.stamp_ns) << ","
+            << ToSeconds(e.stamp_ns) - t0 << "," << e.method << "," << e.mean_residual_m << "\n";
     }
     // Extrinsics over time, and j's pose in G_i.
     std::ofstream ext((dir / (name + "_extrinsics.csv")).string());
@@ -82,7 +82,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
     std::map<int, eval::Trajectory> teammate_tum;
     std::map<int, PairMetrics> by_teammate;
     for (const swarm::DroneOutput& s : scans) {
-      const double t = StampSeconds(s.ego.stamp_ns);
+      const double t = ToSeconds(s.ego.stamp_ns);
       for (const swarm::TeammateEstimate& r : s.teammates) {
         const Eigen::Quaterniond& q = r.T_Gi_Gj.q_Gi_Gj;
         const Eigen::Vector3d& p = r.T_Gi_Gj.p_Gj_in_Gi;
@@ -111,7 +111,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
         m.extrinsic_max_deg = std::max(m.extrinsic_max_deg, e_deg);
         // j's ground truth is stamped in j's clock: the same true instant.
         const driver::TrueClock& clock_j = run.drone(r.drone_id).input().true_clock;
-        const double t_j = StampSeconds(clock_j.ToDrone(d.input().true_clock.ToTrue(s.ego.stamp_ns)));
+        const double t_j = ToSeconds(clock_j.ToDrone(d.input().true_clock.ToTrue(s.ego.stamp_ns)));
         Eigen::Isometry3d T_true_Gj_bj;
         if (r.have_pose && has_truth[r.drone_id] &&
             truth[r.drone_id].PoseAt(t_j, kMaxTruthGapS, &T_true_Gj_bj)) {
@@ -144,7 +144,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
       for (const swarm::IdentificationEvent& e : d.identifications()) {
         if (e.drone_id == j && !m.identified) {
           m.identified = true;
-          m.identification_s = StampSeconds(e.stamp_ns) - t0;
+          m.identification_s = ToSeconds(e.stamp_ns) - t0;
           const Eigen::Isometry3d T_true =
               d.input().T_W_G().inverse() * run.drone(j).input().T_W_G();
           m.initial_error_m = (e.initial_T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm();
@@ -156,8 +156,8 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
             const double start_j_s = ExcitationStart(truth[j]);
             const int64_t start_j_in_i_ns = d.input().true_clock.ToDrone(
                 run.drone(j).input().true_clock.ToTrue(std::llround(start_j_s * 1e9)));
-            m.since_excitation_s = StampSeconds(e.stamp_ns) -
-                                   std::max(ExcitationStart(truth[i]), StampSeconds(start_j_in_i_ns));
+            m.since_excitation_s = ToSeconds(e.stamp_ns) -
+                                   std::max(ExcitationStart(truth[i]), ToSeconds(start_j_in_i_ns));
           }
         }
       }

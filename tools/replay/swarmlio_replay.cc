@@ -221,7 +221,7 @@ void PrintSummary(const replay::DroneRunner& d, double wall_s) {
     std::printf("\n");
   }
   if (scans.size() >= 2) {
-    const double log_s = StampSeconds(scans.back().ego.stamp_ns - scans.front().ego.stamp_ns);
+    const double log_s = ToSeconds(scans.back().ego.stamp_ns - scans.front().ego.stamp_ns);
     double busy_s = 0.0;
     for (const swarm::DroneOutput& s : scans) busy_s += s.ego.timings.total_s;
     std::printf("  log %.1f s, estimator busy %.2f s: %.1fx real time (whole replay %.1f s wall)\n",
@@ -339,7 +339,7 @@ int Main() {
   options.on_progress = [&](const replay::ReplayProgress& p) {
     std::ostringstream detail;
     detail << std::fixed << std::setprecision(1)
-           << StampSeconds(p.stamp_ns - p.start_stamp_ns) << " s";
+           << ToSeconds(p.stamp_ns - p.start_stamp_ns) << " s";
     bar.Update(p.Fraction(), detail.str());
   };
   const auto start = std::chrono::steady_clock::now();

@@ -147,7 +147,7 @@ void RosOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& la
   }
   if (options_.local_map_period_s > 0.0 && drone_ != nullptr &&
       (!map_published_ ||
-       StampSeconds(o.ego.stamp_ns - last_map_stamp_ns_) >= options_.local_map_period_s)) {
+       ToSeconds(o.ego.stamp_ns - last_map_stamp_ns_) >= options_.local_map_period_s)) {
     map_published_ = true;
     last_map_stamp_ns_ = o.ego.stamp_ns;
     if (map_.getNumSubscribers() > 0) {

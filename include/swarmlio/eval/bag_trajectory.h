@@ -11,7 +11,7 @@
 namespace swarmlio::eval {
 
 /// Reads every pose on options.ground_truth_topic of the bag at `path` into a
-/// stamped trajectory (stamps = StampSeconds(header stamp), T_G_b from the
+/// stamped trajectory (stamps = ToSeconds(header stamp), T_G_b from the
 /// pose). BagReader needs IMU and LiDAR topics (found by type when the
 /// configured ones are absent or "auto"); its per-point time check is turned
 /// off (scans are not used), its pose checks drop non-finite and

@@ -5,7 +5,7 @@
 // evo, which reads TUM stamps as float64 and associates them in double
 // arithmetic, so pair decisions at |dt| == t_max_diff only match bit for bit
 // when the stamps are the same doubles (strtod of the file's text). Bag
-// stamps are converted with StampSeconds().
+// stamps are converted with ToSeconds().
 #pragma once
 
 #include <Eigen/Core>
@@ -46,7 +46,7 @@ struct Trajectory {
 };
 
 /// A stamped trajectory from poses of b in G (e.g. estimator output or bag
-/// ground truth): stamps StampSeconds(stamp_ns), rotations from the
+/// ground truth): stamps ToSeconds(stamp_ns), rotations from the
 /// normalised quaternions. No checks (see ValidateTrajectory).
 Trajectory TrajectoryFromPoses(const std::vector<PoseStamped>& poses);
 

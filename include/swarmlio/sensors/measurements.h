@@ -17,8 +17,6 @@
 
 namespace swarmlio {
 
-/// The name of ToSeconds() older code uses (common/time.h); identical.
-inline double StampSeconds(int64_t stamp_ns) { return ToSeconds(stamp_ns); }
 
 /// One IMU sample. Acceleration is the specific force as the device reports
 /// it (m/s^2 for most IMUs, g for Livox built-in IMUs; the estimator's IMU
