@@ -1,16 +1,12 @@
 #include "src/lio/filter_back_end.h"
 
+#include "swarmlio/common/stopwatch.h"
+
 #include <chrono>
 
 namespace swarmlio::lio::internal {
 namespace {
-
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 }  // namespace
 
 FilterBackEnd::FilterBackEnd(const OdometryOptions& options, LocalMap* map,

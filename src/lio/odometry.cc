@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "swarmlio/common/stopwatch.h"
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/in_flight_alignment.h"
@@ -20,10 +21,6 @@ namespace swarmlio::lio {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 int64_t ScanEndNs(const LidarScan& scan) {
   double last_s = 0.0;

@@ -1,4 +1,3 @@
-#include "swarmlio/common/time.h"
 #include "swarmlio/swarm/drone_estimator.h"
 
 #include <algorithm>
@@ -14,14 +13,12 @@
 #include "observation_gate.h"
 #include "passive_observation_updater.h"
 #include "scan_report.h"
+#include "swarmlio/common/stopwatch.h"
+#include "swarmlio/common/time.h"
 #include "teammate_registry.h"
 
 namespace swarmlio::swarm {
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 }  // namespace
 

@@ -1,5 +1,6 @@
-#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/cv_filter.h"
+
+#include "swarmlio/common/time.h"
 
 #include <Eigen/Cholesky>
 #include <cmath>

@@ -1,5 +1,6 @@
-#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/odometry_history.h"
+
+#include "swarmlio/common/time.h"
 
 #include <algorithm>
 #include <cmath>

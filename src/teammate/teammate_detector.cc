@@ -1,4 +1,3 @@
-#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/teammate_detector.h"
 
 #include <algorithm>
@@ -6,6 +5,7 @@
 #include <string>
 
 #include "swarmlio/common/check.h"
+#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/association.h"
 #include "swarmlio/teammate/point_removal.h"
 #include "swarmlio/teammate/trajectory_matcher.h"

@@ -1,5 +1,6 @@
-#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/teammate_tracker.h"
+
+#include "swarmlio/common/time.h"
 
 #include <cmath>
 

@@ -1,18 +1,14 @@
 #include "src/window/window_back_end.h"
 
+#include "swarmlio/common/stopwatch.h"
+
 #include <chrono>
 #include <string>
 #include <utility>
 
 namespace swarmlio::lio::internal {
 namespace {
-
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 }  // namespace
 
 WindowBackEnd::WindowBackEnd(const OdometryOptions& options, LocalMap* map,

@@ -22,6 +22,7 @@
 #include "factors/marginalization_prior_factor.h"
 #include "factors/point_to_plane_factor.h"
 #include "factors/pose_information_factor.h"
+#include "swarmlio/common/stopwatch.h"
 #include "swarmlio/lio/imu_preintegration.h"
 #include "swarmlio/window/marginalization.h"
 #include "window_smoother.h"
@@ -33,10 +34,6 @@ using EgoParameters = std::array<double, EgoState::kAmbientSize>;
 using TeammateParameters = std::array<double, GlobalExtrinsic::kAmbientSize>;
 constexpr int kEgoDim = EgoState::kTangentSize;
 constexpr int kTeammateDim = GlobalExtrinsic::kTangentSize;
-
-inline double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // One scan state of the window.
 struct WindowScan {

@@ -1,5 +1,6 @@
-#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/observation.h"
+
+#include "swarmlio/common/time.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,3 @@
-#include "swarmlio/common/time.h"
 #include "swarmlio/teammate/trajectory_matcher.h"
 
 #include <gtest/gtest.h>
@@ -7,6 +6,7 @@
 #include <limits>
 #include <random>
 
+#include "swarmlio/common/time.h"
 #include "swarmlio/math/so3.h"
 
 namespace swarmlio::teammate {
