@@ -13,10 +13,6 @@ using L = ErrorStateLayout;
 constexpr int kDim = 15;  // [dtheta dp dv dbg dba]: the ego segments before gravity
 static_assert(L::kGravity.offset == kDim, "gravity must be the last ego segment");
 
-bool IsFinite(const ImuInput& u) {
-  return u.angular_velocity_rad_s.allFinite() && u.specific_force_m_s2.allFinite();
-}
-
 }  // namespace
 
 std::string ImuPreintegrationOptions::Validate() const {
@@ -50,8 +46,8 @@ Status ImuPreintegration::Reset(int64_t start_stamp_ns,
                                 const Eigen::Vector3d& gyro_bias,
                                 const Eigen::Vector3d& accel_bias) {
   const ImuInput u = ToImuInput(last_sample, acceleration_to_m_s2);
-  if (!IsFinite(u) || !std::isfinite(acceleration_to_m_s2) || !gyro_bias.allFinite() ||
-      !accel_bias.allFinite()) {
+  if (!u.angular_velocity_rad_s.allFinite() || !u.specific_force_m_s2.allFinite() ||
+      !std::isfinite(acceleration_to_m_s2) || !gyro_bias.allFinite() || !accel_bias.allFinite()) {
     return Status::InvalidArgument(
         "imu preintegration: non-finite initial sample, unit factor or biases");
   }
@@ -61,10 +57,7 @@ Status ImuPreintegration::Reset(int64_t start_stamp_ns,
        << " ns) must not be after the start " << start_stamp_ns << " ns";
     return Status::InvalidArgument(os.str());
   }
-  stamp_ns_ = start_stamp_ns;
-  last_sample_stamp_ns_ = last_sample.stamp_ns;
-  last_input_ = u;
-  acceleration_to_m_s2_ = acceleration_to_m_s2;
+  stepper_.Reset(start_stamp_ns, last_sample, acceleration_to_m_s2);
   initialized_ = true;
   Restart(gyro_bias, accel_bias);
   return Status::Ok();
@@ -79,7 +72,7 @@ double ImuPreintegration::SumOfSquaredSteps() const {
 void ImuPreintegration::Restart(const Eigen::Vector3d& gyro_bias,
                                 const Eigen::Vector3d& accel_bias) {
   CHECK(initialized_) << "ImuPreintegration::Restart before Reset";
-  start_stamp_ns_ = stamp_ns_;
+  start_stamp_ns_ = stepper_.stamp_ns();
   steps_.clear();
   ClearIntegral(gyro_bias, accel_bias);
   Publish();
@@ -117,17 +110,17 @@ void ImuPreintegration::Integrate(const Step& step) {
   covariance_ = 0.5 * (P + P.transpose());
 }
 
-void ImuPreintegration::Advance(const ImuInput& u, int64_t stamp_ns) {
-  const Step step{u, ToSeconds(stamp_ns - stamp_ns_)};
-  Integrate(step);
-  steps_.push_back(step);
-  stamp_ns_ = stamp_ns;
+void ImuPreintegration::Advance(const ImuStep& step) {
+  const Step recorded{step.input, step.dt_s};
+  Integrate(recorded);
+  steps_.push_back(recorded);
+  stepper_.Advance(step);
   Publish();
 }
 
 void ImuPreintegration::Publish() {
   PreintegratedImu& m = preintegrated_;
-  m.dt_s = ToSeconds(stamp_ns_ - start_stamp_ns_);
+  m.dt_s = ToSeconds(stepper_.stamp_ns() - start_stamp_ns_);
   m.delta_R = delta_.R_G_b();
   m.delta_v = delta_.v_b_in_G;
   m.delta_p = delta_.p_b_in_G;
@@ -148,84 +141,24 @@ void ImuPreintegration::Publish() {
       floor * floor * Eigen::Matrix3d::Identity();
 }
 
-Status ImuPreintegration::CheckGap(int64_t stamp_ns) const {
-  const double dt = ToSeconds(stamp_ns - stamp_ns_);
-  if (dt <= options_.max_gap_s) return Status::Ok();
-  std::ostringstream os;
-  os << "imu preintegration: gap of " << dt << " s from " << stamp_ns_ << " ns to " << stamp_ns
-     << " ns exceeds max_gap_s = " << options_.max_gap_s << " s; not integrated";
-  return Status::OutOfRange(os.str());
-}
-
 Status ImuPreintegration::AddImu(const ImuSample& sample) {
   CHECK(initialized_) << "ImuPreintegration::AddImu before Reset";
-  const ImuInput u = ToImuInput(sample, acceleration_to_m_s2_);
-  if (!IsFinite(u)) {
-    ++num_rejected_non_finite_;
-    return Status::InvalidArgument("imu preintegration: non-finite IMU sample at stamp " +
-                                   std::to_string(sample.stamp_ns) + " ns rejected");
-  }
-  if (sample.stamp_ns == last_sample_stamp_ns_) {
-    ++num_skipped_duplicate_;
-    return Status::Ok();
-  }
-  if (sample.stamp_ns == stamp_ns_ && sample.stamp_ns > last_sample_stamp_ns_) {
-    // IntegrateTo() already reached this stamp: the sample only becomes the
-    // input from here on.
-    last_input_ = u;
-    last_sample_stamp_ns_ = sample.stamp_ns;
-    return Status::Ok();
-  }
-  if (sample.stamp_ns <= stamp_ns_) {
-    ++num_skipped_out_of_order_;
-    return Status::Ok();
-  }
-  const Status gap = CheckGap(sample.stamp_ns);
-  if (!gap.ok()) {
-    ++num_gaps_;
-    return gap;
-  }
-  Advance(MidpointInput(u, sample.stamp_ns, sample.stamp_ns), sample.stamp_ns);
-  last_input_ = u;
-  last_sample_stamp_ns_ = sample.stamp_ns;
+  ImuSampleStepper::Action action;
+  ImuStep step;
+  const Status status = stepper_.Accept(sample, &action, &step);
+  if (!status.ok() || action == ImuSampleStepper::Action::kSkip) return status;
+  if (action == ImuSampleStepper::Action::kStep) Advance(step);
+  stepper_.Hold(sample);
   return Status::Ok();
 }
 
 Status ImuPreintegration::IntegrateTo(int64_t stamp_ns, const ImuSample* next_sample) {
   CHECK(initialized_) << "ImuPreintegration::IntegrateTo before Reset";
-  if (stamp_ns == stamp_ns_) return Status::Ok();
-  if (stamp_ns < stamp_ns_) {
-    std::ostringstream os;
-    os << "imu preintegration: cannot integrate back in time from " << stamp_ns_ << " ns to "
-       << stamp_ns << " ns";
-    return Status::OutOfRange(os.str());
-  }
-  ImuInput u = last_input_;  // zero-order hold
-  if (next_sample != nullptr) {
-    const ImuInput next = ToImuInput(*next_sample, acceleration_to_m_s2_);
-    if (next_sample->stamp_ns < stamp_ns || !IsFinite(next)) {
-      std::ostringstream os;
-      os << "imu preintegration: next sample (stamp " << next_sample->stamp_ns
-         << " ns) must be finite and not before the target " << stamp_ns << " ns";
-      return Status::InvalidArgument(os.str());
-    }
-    u = MidpointInput(next, next_sample->stamp_ns, stamp_ns);
-  }
-  const Status gap = CheckGap(stamp_ns);
-  if (!gap.ok()) {
-    ++num_gaps_;
-    return gap;
-  }
-  Advance(u, stamp_ns);
-  return Status::Ok();
-}
-
-// The propagator's interpolation (the same function: same rounding).
-ImuInput ImuPreintegration::MidpointInput(const ImuInput& next,
-                                          int64_t next_stamp_ns,
-                                          int64_t end_ns) const {
-  return lio::MidpointInput(last_input_, last_sample_stamp_ns_, next, next_stamp_ns, stamp_ns_,
-                                 end_ns);
+  ImuStep step;
+  bool needed = false;
+  const Status status = stepper_.StepTo(stamp_ns, next_sample, &step, &needed);
+  if (status.ok() && needed) Advance(step);
+  return status;
 }
 
 }  // namespace swarmlio::lio

@@ -45,13 +45,6 @@ Interval MakeInterval(const EgoState& x,
 
 }  // namespace
 
-ImuInput ToImuInput(const ImuSample& sample, double acceleration_to_m_s2) {
-  ImuInput u;
-  u.angular_velocity_rad_s = sample.angular_velocity_rad_s;
-  u.specific_force_m_s2 = acceleration_to_m_s2 * sample.linear_acceleration;
-  return u;
-}
-
 EgoState PropagateEgo(const EgoState& x, const ImuInput& u, double dt_s, const ImuNoiseVector& w) {
   const Interval k = MakeInterval(x, u, dt_s, w);
   EgoState y = x;
@@ -140,11 +133,7 @@ Status ImuPropagator::Reset(const SwarmState& state,
   }
   state_ = state;
   P_ = P;
-  stamp_ns_ = sample.stamp_ns;
-  last_sample_stamp_ns_ = sample.stamp_ns;
-  last_sample_ = sample;
-  last_input_ = u;
-  acceleration_to_m_s2_ = acceleration_to_m_s2;
+  stepper_.Reset(sample.stamp_ns, sample, acceleration_to_m_s2);
   initialized_ = true;
   StartScan();
   return Status::Ok();
@@ -157,112 +146,31 @@ Status ImuPropagator::Reset(const ImuInitialization& init) {
                init.acceleration_to_m_s2);
 }
 
-Status ImuPropagator::CheckGap(int64_t stamp_ns) const {
-  const double dt = ToSeconds(stamp_ns - stamp_ns_);
-  if (dt <= options_.max_gap_s) return Status::Ok();
-  std::ostringstream os;
-  os << "imu propagator: gap of " << dt << " s from " << stamp_ns_ << " ns to " << stamp_ns
-     << " ns exceeds max_gap_s = " << options_.max_gap_s << " s; not propagated (re-initialize)";
-  return Status::OutOfRange(os.str());
-}
-
 Status ImuPropagator::AddImu(const ImuSample& sample) {
   CHECK(initialized_) << "ImuPropagator::AddImu before Reset";
-  const ImuInput u = ToImuInput(sample, acceleration_to_m_s2_);
-  if (!u.angular_velocity_rad_s.allFinite() || !u.specific_force_m_s2.allFinite()) {
-    ++num_rejected_non_finite_;
-    return Status::InvalidArgument("imu propagator: non-finite IMU sample at stamp " +
-                                   std::to_string(sample.stamp_ns) + " ns rejected");
-  }
-  if (sample.stamp_ns == last_sample_stamp_ns_) {
-    ++num_skipped_duplicate_;
-    return Status::Ok();
-  }
-  if (sample.stamp_ns == stamp_ns_ && sample.stamp_ns > last_sample_stamp_ns_) {
-    // PropagateTo() already reached this stamp: the sample only becomes the
-    // input from here on.
-    last_input_ = u;
-    last_sample_stamp_ns_ = sample.stamp_ns;
-    last_sample_ = sample;
-    scan_poses_.back() = CurrentPose(u);
-    return Status::Ok();
-  }
-  if (sample.stamp_ns <= stamp_ns_) {
-    ++num_skipped_out_of_order_;
-    return Status::Ok();
-  }
-  const Status gap = CheckGap(sample.stamp_ns);
-  if (!gap.ok()) {
-    ++num_gaps_;
-    return gap;
-  }
-  // Input at the midpoint time of [stamp_ns_, sample], linearly interpolated
-  // between the previous sample and this one (the plain mean of the two when
-  // the state sits on the previous sample).
-  const ImuInput mid = MidpointInput(u, sample.stamp_ns, sample.stamp_ns);
-  Step(mid, ToSeconds(sample.stamp_ns - stamp_ns_), sample.stamp_ns);
-  last_input_ = u;
-  last_sample_stamp_ns_ = sample.stamp_ns;
-  last_sample_ = sample;
-  // The new pose's held input is the sample itself until the next step.
-  scan_poses_.back() = CurrentPose(u);
+  ImuSampleStepper::Action action;
+  ImuStep step;
+  const Status status = stepper_.Accept(sample, &action, &step);
+  if (!status.ok() || action == ImuSampleStepper::Action::kSkip) return status;
+  if (action == ImuSampleStepper::Action::kStep) Step(step);
+  stepper_.Hold(sample);
+  // The newest pose's held input is the sample itself until the next step.
+  scan_poses_.back() = CurrentPose(stepper_.last_input());
   return Status::Ok();
 }
 
 Status ImuPropagator::PropagateTo(int64_t stamp_ns, const ImuSample* next_sample) {
   CHECK(initialized_) << "ImuPropagator::PropagateTo before Reset";
-  if (stamp_ns == stamp_ns_) return Status::Ok();
-  if (stamp_ns < stamp_ns_) {
-    std::ostringstream os;
-    os << "imu propagator: cannot propagate back in time from " << stamp_ns_ << " ns to "
-       << stamp_ns << " ns";
-    return Status::OutOfRange(os.str());
-  }
-  ImuInput u = last_input_;  // zero-order hold
-  if (next_sample != nullptr) {
-    const ImuInput next = ToImuInput(*next_sample, acceleration_to_m_s2_);
-    if (next_sample->stamp_ns < stamp_ns || !next.angular_velocity_rad_s.allFinite() ||
-        !next.specific_force_m_s2.allFinite()) {
-      std::ostringstream os;
-      os << "imu propagator: next sample (stamp " << next_sample->stamp_ns
-         << " ns) must be finite and not before the target " << stamp_ns << " ns";
-      return Status::InvalidArgument(os.str());
-    }
-    u = MidpointInput(next, next_sample->stamp_ns, stamp_ns);
-  }
-  const Status gap = CheckGap(stamp_ns);
-  if (!gap.ok()) {
-    ++num_gaps_;
-    return gap;
-  }
-  Step(u, ToSeconds(stamp_ns - stamp_ns_), stamp_ns);
-  return Status::Ok();
-}
-
-ImuInput MidpointInput(const ImuInput& last, int64_t last_stamp_ns, const ImuInput& next,
-                       int64_t next_stamp_ns, int64_t from_ns, int64_t to_ns) {
-  const double span_s = ToSeconds(next_stamp_ns - last_stamp_ns);
-  const double t_mid_s =
-      0.5 * (ToSeconds(from_ns - last_stamp_ns) + ToSeconds(to_ns - last_stamp_ns));
-  const double alpha = span_s > 0.0 ? t_mid_s / span_s : 0.0;
-  ImuInput mid;
-  mid.angular_velocity_rad_s =
-      last.angular_velocity_rad_s + alpha * (next.angular_velocity_rad_s - last.angular_velocity_rad_s);
-  mid.specific_force_m_s2 =
-      last.specific_force_m_s2 + alpha * (next.specific_force_m_s2 - last.specific_force_m_s2);
-  return mid;
-}
-
-ImuInput ImuPropagator::MidpointInput(const ImuInput& next,
-                                      int64_t next_stamp_ns,
-                                      int64_t end_ns) const {
-  return lio::MidpointInput(last_input_, last_sample_stamp_ns_, next, next_stamp_ns, stamp_ns_,
-                                 end_ns);
+  ImuStep step;
+  bool needed = false;
+  const Status status = stepper_.StepTo(stamp_ns, next_sample, &step, &needed);
+  if (status.ok() && needed) Step(step);
+  return status;
 }
 
 void ImuPropagator::StartScan() {
   scan_poses_.clear();
-  scan_poses_.push_back(CurrentPose(last_input_));
+  scan_poses_.push_back(CurrentPose(stepper_.last_input()));
 }
 
 void ImuPropagator::SetState(const SwarmState& state, const Eigen::MatrixXd& P) {
@@ -276,7 +184,7 @@ void ImuPropagator::SetState(const SwarmState& state, const Eigen::MatrixXd& P) 
 ImuPose ImuPropagator::CurrentPose(const ImuInput& u) const {
   const EgoState& x = state_.ego;
   ImuPose pose;
-  pose.stamp_ns = stamp_ns_;
+  pose.stamp_ns = stepper_.stamp_ns();
   pose.R_G_b = x.R_G_b();
   pose.p_b_in_G = x.p_b_in_G;
   pose.v_b_in_G = x.v_b_in_G;
@@ -285,19 +193,19 @@ ImuPose ImuPropagator::CurrentPose(const ImuInput& u) const {
   return pose;
 }
 
-void ImuPropagator::Step(const ImuInput& u, double dt_s, int64_t stamp_ns) {
+void ImuPropagator::Step(const ImuStep& step) {
   EgoMatrix F;
   EgoNoiseMatrix G;
-  EgoProcessJacobians(state_.ego, u, dt_s, &F, &G);
+  EgoProcessJacobians(state_.ego, step.input, step.dt_s, &F, &G);
   // The pose that starts this interval holds exactly the input integrated.
-  const Interval k = MakeInterval(state_.ego, u, dt_s, ImuNoiseVector::Zero());
+  const Interval k = MakeInterval(state_.ego, step.input, step.dt_s, ImuNoiseVector::Zero());
   scan_poses_.back().angular_velocity_in_b_rad_s = k.w;
   scan_poses_.back().acc_in_G_m_s2 = k.acc_in_G;
 
-  state_.ego = PropagateEgo(state_.ego, u, dt_s);
-  PropagateCovariance(F, G, dt_s);
-  stamp_ns_ = stamp_ns;
-  scan_poses_.push_back(CurrentPose(u));
+  state_.ego = PropagateEgo(state_.ego, step.input, step.dt_s);
+  PropagateCovariance(F, G, step.dt_s);
+  stepper_.Advance(step);
+  scan_poses_.push_back(CurrentPose(step.input));
 }
 
 void ImuPropagator::PropagateCovariance(const EgoMatrix& F, const EgoNoiseMatrix& G, double dt_s) {

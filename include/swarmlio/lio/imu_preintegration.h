@@ -116,7 +116,7 @@ class ImuPreintegration {
   const Matrix15& covariance() const { return covariance_; }
 
   int64_t start_stamp_ns() const { return start_stamp_ns_; }
-  int64_t stamp_ns() const { return stamp_ns_; }
+  int64_t stamp_ns() const { return stepper_.stamp_ns(); }
   bool initialized() const { return initialized_; }
   /// Integration steps of the current interval.
   int num_intervals() const { return static_cast<int>(steps_.size()); }
@@ -125,10 +125,10 @@ class ImuPreintegration {
   /// teammate variances (docs/imu.md).
   double SumOfSquaredSteps() const;
 
-  int num_skipped_duplicate() const { return num_skipped_duplicate_; }
-  int num_skipped_out_of_order() const { return num_skipped_out_of_order_; }
-  int num_rejected_non_finite() const { return num_rejected_non_finite_; }
-  int num_gaps() const { return num_gaps_; }
+  int num_skipped_duplicate() const { return stepper_.num_skipped_duplicate(); }
+  int num_skipped_out_of_order() const { return stepper_.num_skipped_out_of_order(); }
+  int num_rejected_non_finite() const { return stepper_.num_rejected_non_finite(); }
+  int num_gaps() const { return stepper_.num_gaps(); }
 
  private:
   struct Step {
@@ -137,37 +137,30 @@ class ImuPreintegration {
   };
 
   explicit ImuPreintegration(const ImuPreintegrationOptions& options)
-      : options_(options), Q_(EgoNoiseCovariance(options.process_noise)) {}
+      : options_(options),
+        Q_(EgoNoiseCovariance(options.process_noise)),
+        stepper_("imu preintegration", options.max_gap_s, "not integrated") {}
 
   // Resets the Deltas, Phi and P to the start of the interval.
   void ClearIntegral(const Eigen::Vector3d& gyro_bias, const Eigen::Vector3d& accel_bias);
   // One step of the model, Phi and P; does not record it.
   void Integrate(const Step& step);
-  // Integrates, records the step and ends at stamp_ns.
-  void Advance(const ImuInput& u, int64_t stamp_ns);
+  // Integrates, records the step and ends at its end.
+  void Advance(const ImuStep& step);
   // Copies the integral into preintegrated_.
   void Publish();
-  Status CheckGap(int64_t stamp_ns) const;
-  ImuInput MidpointInput(const ImuInput& next, int64_t next_stamp_ns, int64_t end_ns) const;
 
   ImuPreintegrationOptions options_;
   Eigen::Matrix<double, ImuNoiseLayout::kDim, ImuNoiseLayout::kDim> Q_;  // per IMU interval
   bool initialized_ = false;
+  ImuSampleStepper stepper_;  // time, last sample and input, sample counters
   int64_t start_stamp_ns_ = 0;
-  int64_t stamp_ns_ = 0;
-  int64_t last_sample_stamp_ns_ = 0;
-  ImuInput last_input_;
-  double acceleration_to_m_s2_ = 1.0;
   // The integral as a propagator state: (DeltaR, Deltap, Deltav, bg_bar, ba_bar, g = 0).
   EgoState delta_;
   Matrix15 transition_ = Matrix15::Identity();  // Phi
   Matrix15 covariance_ = Matrix15::Zero();      // P
   std::vector<Step> steps_;
   PreintegratedImu preintegrated_;
-  int num_skipped_duplicate_ = 0;
-  int num_skipped_out_of_order_ = 0;
-  int num_rejected_non_finite_ = 0;
-  int num_gaps_ = 0;
 };
 
 }  // namespace swarmlio::lio

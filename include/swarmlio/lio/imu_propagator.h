@@ -28,6 +28,7 @@
 
 #include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
+#include "swarmlio/lio/imu_sample_stepper.h"
 #include "swarmlio/lio/process_noise_options.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/state_layout.h"
@@ -49,23 +50,6 @@ struct ImuNoiseLayout {
 using EgoMatrix = Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>;
 using EgoNoiseMatrix = Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ImuNoiseLayout::kDim>;
 using ImuNoiseVector = Eigen::Matrix<double, ImuNoiseLayout::kDim, 1>;
-
-/// IMU input in SI units and the IMU frame (sign and unit already applied).
-struct ImuInput {
-  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  // w_m
-  Eigen::Vector3d specific_force_m_s2 = Eigen::Vector3d::Zero();     // a_m
-};
-
-/// Converts a raw sample: a_m = acceleration_to_m_s2 * linear_acceleration
-/// (the signed factor from ImuInitialization).
-ImuInput ToImuInput(const ImuSample& sample, double acceleration_to_m_s2);
-
-/// The input held over [from_ns, to_ns]: the linear interpolation between the
-/// last sample (`last` at `last_stamp_ns`) and `next` (at `next_stamp_ns`),
-/// taken at the interval's midpoint (the propagator's discrete model; the
-/// preintegration uses the same function so the two agree to round-off).
-ImuInput MidpointInput(const ImuInput& last, int64_t last_stamp_ns, const ImuInput& next,
-                       int64_t next_stamp_ns, int64_t from_ns, int64_t to_ns);
 
 /// One step of the discrete model above (ego part) with noise w.
 EgoState PropagateEgo(const EgoState& x,
@@ -155,46 +139,36 @@ class ImuPropagator {
 
   const SwarmState& state() const { return state_; }
   const Eigen::MatrixXd& covariance() const { return P_; }
-  int64_t stamp_ns() const { return stamp_ns_; }
+  int64_t stamp_ns() const { return stepper_.stamp_ns(); }
   /// The last accepted IMU sample (raw units): the input held at stamp_ns()
   /// (the window smoother's preintegration starts from it).
-  const ImuSample& last_sample() const { return last_sample_; }
+  const ImuSample& last_sample() const { return stepper_.last_sample(); }
   bool initialized() const { return initialized_; }
   /// Poses of the current scan: the state at StartScan(), then one per
   /// propagation step (IMU samples, then the PropagateTo() target).
   const std::vector<ImuPose>& scan_poses() const { return scan_poses_; }
 
-  int num_skipped_duplicate() const { return num_skipped_duplicate_; }
-  int num_skipped_out_of_order() const { return num_skipped_out_of_order_; }
-  int num_rejected_non_finite() const { return num_rejected_non_finite_; }
-  int num_gaps() const { return num_gaps_; }
+  int num_skipped_duplicate() const { return stepper_.num_skipped_duplicate(); }
+  int num_skipped_out_of_order() const { return stepper_.num_skipped_out_of_order(); }
+  int num_rejected_non_finite() const { return stepper_.num_rejected_non_finite(); }
+  int num_gaps() const { return stepper_.num_gaps(); }
 
  private:
-  explicit ImuPropagator(const ImuPropagatorOptions& options) : options_(options) {}
+  explicit ImuPropagator(const ImuPropagatorOptions& options)
+      : options_(options),
+        stepper_("imu propagator", options.max_gap_s, "not propagated (re-initialize)") {}
 
-  // Propagates by dt with input u, ends at stamp_ns, appends a scan pose.
-  void Step(const ImuInput& u, double dt_s, int64_t stamp_ns);
+  // Propagates over the step and appends a scan pose at its end.
+  void Step(const ImuStep& step);
   void PropagateCovariance(const EgoMatrix& F, const EgoNoiseMatrix& G, double dt_s);
   ImuPose CurrentPose(const ImuInput& u) const;
-  Status CheckGap(int64_t stamp_ns) const;
-  // Input at the midpoint of [stamp_ns_, end_ns], linear between the last
-  // sample and `next` (at next_stamp_ns).
-  ImuInput MidpointInput(const ImuInput& next, int64_t next_stamp_ns, int64_t end_ns) const;
 
   ImuPropagatorOptions options_;
   bool initialized_ = false;
   SwarmState state_;
   Eigen::MatrixXd P_;
-  int64_t stamp_ns_ = 0;
-  int64_t last_sample_stamp_ns_ = 0;  // stamp of the last accepted IMU sample
-  ImuSample last_sample_;             // that sample (raw units)
-  ImuInput last_input_;               // that sample's input (SI units)
-  double acceleration_to_m_s2_ = 1.0;
+  ImuSampleStepper stepper_;  // time, last sample and input, sample counters
   std::vector<ImuPose> scan_poses_;
-  int num_skipped_duplicate_ = 0;
-  int num_skipped_out_of_order_ = 0;
-  int num_rejected_non_finite_ = 0;
-  int num_gaps_ = 0;
 };
 
 }  // namespace swarmlio::lio
