@@ -1,6 +1,6 @@
 // MarginalizationPriorFactor: the linear prior that the fixed-lag window
 // keeps on its remaining blocks when a state leaves the window (issue #12,
-// docs/window.md "Marginalization prior"). swarmlio::Marginalizer
+// docs/window.md "Marginalization prior"). swarmlio::window::Marginalizer
 // (include/swarmlio/window/marginalization.h) builds the MarginalizationPrior
 // below; this factor turns it into one Ceres residual over the kept blocks.
 //
@@ -82,7 +82,7 @@
 namespace swarmlio {
 
 /// The Schur complement of a marginalization, over the kept blocks in order
-/// (built by swarmlio::Marginalizer).
+/// (built by swarmlio::window::Marginalizer).
 struct MarginalizationPrior {
   /// H* (n x n, symmetric positive semi-definite) in the kept blocks' tangent
   /// coordinates at x0, blocks in the order below.

@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "swarmlio/lio/local_map.h"
-#include "swarmlio/lio/odometry.h"
 #include "swarmlio/lio/scan_stages.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/swarm_state.h"
@@ -27,8 +26,10 @@ class BackEnd {
   /// exactly what the propagator consumes: StartInterval at the propagator's
   /// time with its last sample, AddImu per sample, IntegrateTo the scan end
   /// (the filter's are no-ops: the propagator is its process model).
-  virtual void StartInterval(int64_t stamp_ns, const ImuSample& last_sample,
-                             double acceleration_to_m_s2, const EgoState& newest) = 0;
+  virtual void StartInterval(int64_t stamp_ns,
+                             const ImuSample& last_sample,
+                             double acceleration_to_m_s2,
+                             const EgoState& newest) = 0;
   virtual void AddImu(const ImuSample& sample) = 0;
   virtual void IntegrateTo(int64_t stamp_ns, const ImuSample* next_sample) = 0;
 
@@ -54,10 +55,12 @@ class BackEnd {
 /// listed in skip_indices into `map` (moving its box to x) and returns how
 /// many were excluded. registered_in_G (cleared) gets every point not
 /// excluded.
-int InsertScan(const std::vector<Eigen::Vector3d>& points_in_b, const EgoState& x,
+int InsertScan(const std::vector<Eigen::Vector3d>& points_in_b,
+               const EgoState& x,
                const std::vector<ExcludedRegion>& excluded,
                std::vector<Eigen::Vector3d>* registered_in_G,
-               const std::vector<int>* skip_indices, LocalMap* map);
+               const std::vector<int>* skip_indices,
+               LocalMap* map);
 
 /// Whether every value of x and P is finite (a posterior a back end keeps).
 bool IsFinite(const SwarmState& x, const Eigen::MatrixXd& P);

@@ -5,6 +5,9 @@
 #include <cmath>
 #include <utility>
 
+#include "odometry_impl.h"
+#include "src/lio/filter_back_end.h"
+#include "src/window/window_back_end.h"
 #include "swarmlio/common/stopwatch.h"
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
@@ -13,9 +16,6 @@
 #include "swarmlio/lio/preprocess.h"
 #include "swarmlio/lio/scan_association.h"
 #include "swarmlio/lio/undistortion.h"
-#include "odometry_impl.h"
-#include "src/lio/filter_back_end.h"
-#include "src/window/window_back_end.h"
 
 namespace swarmlio::lio {
 namespace {
@@ -32,7 +32,8 @@ int64_t ScanEndNs(const LidarScan& scan) {
 
 }  // namespace
 
-Status Odometry::Create(const OdometryOptions& options, const LidarOptions& lidar,
+Status Odometry::Create(const OdometryOptions& options,
+                        const LidarOptions& lidar,
                         std::unique_ptr<Odometry>* odometry) {
   if (const std::string invalid = options.Validate(); !invalid.empty()) {
     return Status::InvalidArgument("odometry options: " + invalid);
@@ -53,7 +54,7 @@ Status Odometry::Create(const OdometryOptions& options, const LidarOptions& lida
 Status Odometry::CreateBackEnd() {
   Impl& im = *impl_;
   if (options_.estimator == EstimatorKind::kWindow) {
-    return internal::WindowBackEnd::Create(options_, &im.map, im.propagator.get(), &im.back_end);
+    return window::WindowBackEnd::Create(options_, &im.map, im.propagator.get(), &im.back_end);
   }
   im.back_end = std::make_unique<internal::FilterBackEnd>(options_, &im.map, im.propagator.get());
   return Status::Ok();
@@ -265,8 +266,8 @@ void Odometry::Predict(ScanContext* scan) {
   // 3. Motion compensation to the scan end.
   t = Clock::now();
   const ImuPropagator& prop = *im.propagator;
-  if (Status status = UndistortPoints(im.points_in_b, scan->raw.stamp_ns, prop.scan_poses(),
-                                      &im.undistorted);
+  if (Status status =
+          UndistortPoints(im.points_in_b, scan->raw.stamp_ns, prop.scan_poses(), &im.undistorted);
       !status.ok()) {
     scan->status = status;
     return;
@@ -330,7 +331,8 @@ bool Odometry::Propagate(ScanContext* scan) {
 void Odometry::Update(const UpdateRequest& request, ScanContext* scan) {
   Impl& im = *impl_;
   // The front end may have changed the teammate blocks.
-  if (scan->x.layout() != im.propagator->state().layout()) im.propagator->SetState(scan->x, scan->P);
+  if (scan->x.layout() != im.propagator->state().layout())
+    im.propagator->SetState(scan->x, scan->P);
   im.back_end->Update(request, im.undistorted, scan, &counters_);
   if (scan->out.updated) im.previous_degenerate = scan->out.degenerate;
 }

@@ -8,7 +8,7 @@
 
 #include "factors/term_linearizer.h"
 
-namespace swarmlio {
+namespace swarmlio::window {
 namespace {
 
 // One parameter block of the system, in [kept | marginalized] order.
@@ -301,4 +301,4 @@ Status Marginalizer::Marginalize(const std::vector<double*>& marginalized,
   return Status::Ok();
 }
 
-}  // namespace swarmlio
+}  // namespace swarmlio::window

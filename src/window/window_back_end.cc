@@ -1,22 +1,25 @@
 #include "src/window/window_back_end.h"
 
-#include "swarmlio/common/stopwatch.h"
-
 #include <chrono>
 #include <string>
 #include <utility>
 
-namespace swarmlio::lio::internal {
+#include "swarmlio/common/stopwatch.h"
+
+namespace swarmlio::window {
 namespace {
 using Clock = std::chrono::steady_clock;
 }  // namespace
 
-WindowBackEnd::WindowBackEnd(const OdometryOptions& options, LocalMap* map,
-                             ImuPropagator* propagator)
+WindowBackEnd::WindowBackEnd(const lio::OdometryOptions& options,
+                             lio::LocalMap* map,
+                             lio::ImuPropagator* propagator)
     : options_(options), map_(map), propagator_(propagator) {}
 
-Status WindowBackEnd::Create(const OdometryOptions& options, LocalMap* map,
-                             ImuPropagator* propagator, std::unique_ptr<BackEnd>* back_end) {
+Status WindowBackEnd::Create(const lio::OdometryOptions& options,
+                             lio::LocalMap* map,
+                             lio::ImuPropagator* propagator,
+                             std::unique_ptr<lio::internal::BackEnd>* back_end) {
   std::unique_ptr<WindowBackEnd> out(new WindowBackEnd(options, map, propagator));
   SWARMLIO_RETURN_IF_ERROR(WindowSmoother::Create(options.window, options.propagation,
                                                   options.association, options.update, map,
@@ -25,8 +28,10 @@ Status WindowBackEnd::Create(const OdometryOptions& options, LocalMap* map,
   return Status::Ok();
 }
 
-void WindowBackEnd::StartInterval(int64_t stamp_ns, const ImuSample& last_sample,
-                                  double acceleration_to_m_s2, const EgoState& newest) {
+void WindowBackEnd::StartInterval(int64_t stamp_ns,
+                                  const ImuSample& last_sample,
+                                  double acceleration_to_m_s2,
+                                  const EgoState& newest) {
   window_->StartInterval(stamp_ns, last_sample, acceleration_to_m_s2, newest);
 }
 
@@ -39,17 +44,18 @@ void WindowBackEnd::IntegrateTo(int64_t stamp_ns, const ImuSample* next_sample) 
 void WindowBackEnd::InsertLeaving(const std::vector<LeavingScan>& leaving) {
   for (const LeavingScan& l : leaving) {
     if (l.insert) {
-      InsertScan(l.points_in_b, l.state, l.excluded, nullptr,
-                 options_.insert_matched_points ? nullptr : &l.matched, map_);
+      lio::internal::InsertScan(l.points_in_b, l.state, l.excluded, nullptr,
+                                options_.insert_matched_points ? nullptr : &l.matched, map_);
     }
   }
 }
 
-void WindowBackEnd::Update(const UpdateRequest& request,
-                           const std::vector<Eigen::Vector3d>& points_in_b, ScanContext* scan,
-                           OdometryCounters* counters) {
+void WindowBackEnd::Update(const lio::UpdateRequest& request,
+                           const std::vector<Eigen::Vector3d>& points_in_b,
+                           lio::ScanContext* scan,
+                           lio::OdometryCounters* counters) {
   SwarmState& x = scan->x;
-  ScanOutput* out = &scan->out;
+  lio::ScanOutput* out = &scan->out;
   const bool enough_points = static_cast<int>(points_in_b.size()) >= options_.min_scan_points;
 
   // The state joins the window; the states beyond K leave it, marginalized.
@@ -64,8 +70,8 @@ void WindowBackEnd::Update(const UpdateRequest& request,
   input.considered_teammates = request.considered_teammates;
   std::vector<LeavingScan> leaving;
   std::string model_error;
-  const Status added = window_->AddState(std::move(input), &leaving, &out->timings.marginalize_s,
-                                         &model_error);
+  const Status added =
+      window_->AddState(std::move(input), &leaving, &out->timings.marginalize_s, &model_error);
   if (!model_error.empty()) {
     out->front_end_error += (out->front_end_error.empty() ? "" : "; ") + model_error;
   }
@@ -75,8 +81,8 @@ void WindowBackEnd::Update(const UpdateRequest& request,
   Clock::time_point t = Clock::now();
   InsertLeaving(leaving);
   if (map_->empty()) {
-    out->num_excluded_points = InsertScan(points_in_b, x.ego, scan->excluded, nullptr, nullptr,
-                                          map_);
+    out->num_excluded_points =
+        lio::internal::InsertScan(points_in_b, x.ego, scan->excluded, nullptr, nullptr, map_);
     if (added.ok()) window_->MarkNewestInMap();
   }
   out->timings.map_update_s = SecondsSince(t);
@@ -95,9 +101,11 @@ void WindowBackEnd::Update(const UpdateRequest& request,
   }
 }
 
-void WindowBackEnd::TakeSolution(const WindowSolveResult& result, bool enough_points,
-                                 ScanContext* scan, OdometryCounters* counters) {
-  ScanOutput* out = &scan->out;
+void WindowBackEnd::TakeSolution(const WindowSolveResult& result,
+                                 bool enough_points,
+                                 lio::ScanContext* scan,
+                                 lio::OdometryCounters* counters) {
+  lio::ScanOutput* out = &scan->out;
   out->timings.build_s = result.build_s;
   out->timings.association_s = result.association_s;
   out->timings.solve_s = result.solve_s;
@@ -113,7 +121,7 @@ void WindowBackEnd::TakeSolution(const WindowSolveResult& result, bool enough_po
   }
   counters->window_restarts = window_->counters().restarts;
   counters->window_reintegrations = window_->counters().reintegrations;
-  if (result.status.ok() && IsFinite(result.state, result.covariance)) {
+  if (result.status.ok() && lio::internal::IsFinite(result.state, result.covariance)) {
     scan->x = result.state;
     scan->P = result.covariance;
     propagator_->SetState(scan->x, scan->P);
@@ -133,9 +141,9 @@ void WindowBackEnd::Flush() {
   std::vector<LeavingScan> scans;
   window_->TakeScansForMap(&scans);
   for (const LeavingScan& s : scans) {
-    InsertScan(s.points_in_b, s.state, s.excluded, nullptr,
-               options_.insert_matched_points ? nullptr : &s.matched, map_);
+    lio::internal::InsertScan(s.points_in_b, s.state, s.excluded, nullptr,
+                              options_.insert_matched_points ? nullptr : &s.matched, map_);
   }
 }
 
-}  // namespace swarmlio::lio::internal
+}  // namespace swarmlio::window

@@ -15,38 +15,48 @@
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/odometry_options.h"
 
-namespace swarmlio::lio::internal {
+namespace swarmlio::window {
 
-class WindowBackEnd final : public BackEnd {
+class WindowBackEnd final : public lio::internal::BackEnd {
  public:
   /// InvalidArgument when the window options do not validate. `map` and
   /// `propagator` must outlive the back end.
-  static Status Create(const OdometryOptions& options, LocalMap* map, ImuPropagator* propagator,
-                       std::unique_ptr<BackEnd>* back_end);
+  static Status Create(const lio::OdometryOptions& options,
+                       lio::LocalMap* map,
+                       lio::ImuPropagator* propagator,
+                       std::unique_ptr<lio::internal::BackEnd>* back_end);
 
-  void StartInterval(int64_t stamp_ns, const ImuSample& last_sample, double acceleration_to_m_s2,
+  void StartInterval(int64_t stamp_ns,
+                     const ImuSample& last_sample,
+                     double acceleration_to_m_s2,
                      const EgoState& newest) override;
   void AddImu(const ImuSample& sample) override;
   void IntegrateTo(int64_t stamp_ns, const ImuSample* next_sample) override;
 
-  void Update(const UpdateRequest& request, const std::vector<Eigen::Vector3d>& points_in_b,
-              ScanContext* scan, OdometryCounters* counters) override;
-  void Commit(const std::vector<Eigen::Vector3d>&, ScanContext*) override {}
+  void Update(const lio::UpdateRequest& request,
+              const std::vector<Eigen::Vector3d>& points_in_b,
+              lio::ScanContext* scan,
+              lio::OdometryCounters* counters) override;
+  void Commit(const std::vector<Eigen::Vector3d>&, lio::ScanContext*) override {}
   void Flush() override;
 
  private:
-  WindowBackEnd(const OdometryOptions& options, LocalMap* map, ImuPropagator* propagator);
+  WindowBackEnd(const lio::OdometryOptions& options,
+                lio::LocalMap* map,
+                lio::ImuPropagator* propagator);
   // The scans that left the window, at their final estimates (only scans
   // that a solve updated; docs/window.md "Map").
   void InsertLeaving(const std::vector<LeavingScan>& leaving);
   // The window's solution into the scan's state and output.
-  void TakeSolution(const WindowSolveResult& result, bool enough_points, ScanContext* scan,
-                    OdometryCounters* counters);
+  void TakeSolution(const WindowSolveResult& result,
+                    bool enough_points,
+                    lio::ScanContext* scan,
+                    lio::OdometryCounters* counters);
 
-  OdometryOptions options_;
-  LocalMap* map_;
-  ImuPropagator* propagator_;
+  lio::OdometryOptions options_;
+  lio::LocalMap* map_;
+  lio::ImuPropagator* propagator_;
   std::unique_ptr<WindowSmoother> window_;
 };
 
-}  // namespace swarmlio::lio::internal
+}  // namespace swarmlio::window

@@ -7,14 +7,16 @@
 #include "factors/constant_block_cost.h"
 #include "window_state.h"
 
-namespace swarmlio::lio::internal {
+namespace swarmlio::window {
 
 WindowSmoother::WindowSmoother() : impl_(std::make_unique<Impl>()) {}
 WindowSmoother::~WindowSmoother() = default;
 
-Status WindowSmoother::Create(const WindowOptions& options, const ImuPropagatorOptions& propagation,
-                              const ScanAssociationOptions& association,
-                              const EsikfUpdateOptions& update, const LocalMap* map,
+Status WindowSmoother::Create(const lio::WindowOptions& options,
+                              const lio::ImuPropagatorOptions& propagation,
+                              const lio::ScanAssociationOptions& association,
+                              const lio::EsikfUpdateOptions& update,
+                              const lio::LocalMap* map,
                               std::unique_ptr<WindowSmoother>* smoother) {
   if (const std::string invalid = options.Validate(); !invalid.empty()) {
     return Status::InvalidArgument("window options: " + invalid);
@@ -40,13 +42,16 @@ Status WindowSmoother::Create(const WindowOptions& options, const ImuPropagatorO
 int WindowSmoother::size() const { return static_cast<int>(impl_->scans.size()); }
 const WindowCounters& WindowSmoother::counters() const { return impl_->counters; }
 
-void WindowSmoother::StartInterval(int64_t stamp_ns, const ImuSample& last_sample,
-                                   double acceleration_to_m_s2, const EgoState& newest) {
+void WindowSmoother::StartInterval(int64_t stamp_ns,
+                                   const ImuSample& last_sample,
+                                   double acceleration_to_m_s2,
+                                   const EgoState& newest) {
   Impl& im = *impl_;
-  im.interval_ok = ImuPreintegration::Create(im.preintegration, &im.interval).ok() &&
-                   im.interval->Reset(stamp_ns, last_sample, acceleration_to_m_s2,
-                                      newest.gyro_bias, newest.accel_bias)
-                       .ok();
+  im.interval_ok =
+      lio::ImuPreintegration::Create(im.preintegration, &im.interval).ok() &&
+      im.interval
+          ->Reset(stamp_ns, last_sample, acceleration_to_m_s2, newest.gyro_bias, newest.accel_bias)
+          .ok();
 }
 
 void WindowSmoother::AddImu(const ImuSample& sample) {
@@ -74,7 +79,8 @@ namespace {
 // Information (and gradient 0) of N(current values, covariance) over blocks.
 Status GaussianSystem(const std::vector<double*>& blocks,
                       const std::vector<const ceres::Manifold*>& manifolds,
-                      const Eigen::MatrixXd& covariance, MarginalizationPrior* system) {
+                      const Eigen::MatrixXd& covariance,
+                      MarginalizationPrior* system) {
   const Eigen::MatrixXd C = 0.5 * (covariance + covariance.transpose());
   const Eigen::LLT<Eigen::MatrixXd> llt(C);
   if (llt.info() != Eigen::Success || !C.allFinite()) {
@@ -106,7 +112,8 @@ Status WindowSmoother::Impl::SetGaussianPrior(const std::vector<double*>& blocks
   return SetPrior(std::move(system));
 }
 
-Status WindowSmoother::Impl::ExtendPrior(double* block, const ceres::Manifold* manifold,
+Status WindowSmoother::Impl::ExtendPrior(double* block,
+                                         const ceres::Manifold* manifold,
                                          const Eigen::MatrixXd& covariance) {
   MarginalizationPrior extra;
   SWARMLIO_RETURN_IF_ERROR(GaussianSystem({block}, {manifold}, covariance, &extra));
@@ -180,23 +187,24 @@ void WindowSmoother::Impl::Leave(WindowScan* scan, std::vector<LeavingScan>* lea
 
 namespace {
 
-bool Names(const OwnedResidualTerm& term, const StateKey& key) {
+bool Names(const lio::OwnedResidualTerm& term, const lio::StateKey& key) {
   return std::find(term.blocks.begin(), term.blocks.end(), key) != term.blocks.end();
 }
 
 }  // namespace
 
-Status WindowSmoother::Impl::AdoptTerm(int64_t stamp_ns, const char* model,
-                                       OwnedResidualTerm* term) const {
-  for (StateKey& key : term->blocks) {
-    if (key.kind() == StateKey::Kind::kEgo) key = StateKey::EgoAt(stamp_ns);
+Status WindowSmoother::Impl::AdoptTerm(int64_t stamp_ns,
+                                       const char* model,
+                                       lio::OwnedResidualTerm* term) const {
+  for (lio::StateKey& key : term->blocks) {
+    if (key.kind() == lio::StateKey::Kind::kEgo) key = lio::StateKey::EgoAt(stamp_ns);
   }
   if (term->cost == nullptr || term->cost->parameter_block_sizes().size() != term->blocks.size()) {
     return Status::InvalidArgument(std::string("window: a residual block of ") + model +
                                    " does not match its state blocks");
   }
   for (size_t b = 0; b < term->blocks.size(); ++b) {
-    const StateKey& key = term->blocks[b];
+    const lio::StateKey& key = term->blocks[b];
     if (BlockOf(key) == nullptr) {
       return Status::InvalidArgument(std::string("window: a residual block of ") + model +
                                      " names " + key.ToString() +
@@ -213,22 +221,23 @@ Status WindowSmoother::Impl::AdoptTerm(int64_t stamp_ns, const char* model,
 
 Status WindowSmoother::Impl::TakeObservations(WindowStateInput* input, WindowScan* scan) {
   Status status;
-  for (MeasurementModel* model : input->models) {
+  for (lio::MeasurementModel* model : input->models) {
     if (model == nullptr) continue;
-    std::vector<OwnedResidualTerm> terms;
+    std::vector<lio::OwnedResidualTerm> terms;
     if (!model->ReleaseTerms(&terms)) {
       status = Status::FailedPrecondition(std::string("window: measurement model ") +
                                           model->name() + " cannot be kept in the window");
       continue;
     }
-    for (OwnedResidualTerm& term : terms) {
+    for (lio::OwnedResidualTerm& term : terms) {
       if (Status adopted = AdoptTerm(scan->stamp_ns, model->name(), &term); !adopted.ok()) {
         status = std::move(adopted);
         continue;
       }
       // Considered teammates: held at the prediction in this scan's terms.
       for (int id : input->considered_teammates) {
-        const auto at = std::find(term.blocks.begin(), term.blocks.end(), StateKey::Extrinsic(id));
+        const auto at =
+            std::find(term.blocks.begin(), term.blocks.end(), lio::StateKey::Extrinsic(id));
         if (at == term.blocks.end() || !input->x_pred.HasTeammate(id)) continue;
         std::vector<double> value(GlobalExtrinsic::kAmbientSize);
         input->x_pred.teammate(id).ToParameters(value.data());
@@ -272,8 +281,8 @@ Status WindowSmoother::Impl::RemoveTeammate(int id) {
   for (auto& s : scans) {
     auto& obs = s->observations;
     obs.erase(std::remove_if(obs.begin(), obs.end(),
-                             [id](const OwnedResidualTerm& t) {
-                               return Names(t, StateKey::Extrinsic(id));
+                             [id](const lio::OwnedResidualTerm& t) {
+                               return Names(t, lio::StateKey::Extrinsic(id));
                              }),
               obs.end());
   }
@@ -290,13 +299,15 @@ Status WindowSmoother::Impl::RemoveTeammate(int id) {
     SWARMLIO_RETURN_IF_ERROR(marginalizer->Marginalize({T}, others, &system));
     SWARMLIO_RETURN_IF_ERROR(SetPrior(std::move(system)));
   }
-  teammates.erase(std::remove_if(teammates.begin(), teammates.end(),
-                                 [id](const std::unique_ptr<TeammateBlock>& t) { return t->id == id; }),
-                  teammates.end());
+  teammates.erase(
+      std::remove_if(teammates.begin(), teammates.end(),
+                     [id](const std::unique_ptr<TeammateBlock>& t) { return t->id == id; }),
+      teammates.end());
   return Status::Ok();
 }
 
-Status WindowSmoother::Impl::SyncTeammates(const SwarmState& x_pred, const Eigen::MatrixXd& P_pred) {
+Status WindowSmoother::Impl::SyncTeammates(const SwarmState& x_pred,
+                                           const Eigen::MatrixXd& P_pred) {
   const std::vector<int>& ids = x_pred.layout().teammate_ids();
   std::vector<int> gone;
   for (const auto& t : teammates) {
@@ -305,10 +316,9 @@ Status WindowSmoother::Impl::SyncTeammates(const SwarmState& x_pred, const Eigen
   for (int id : gone) SWARMLIO_RETURN_IF_ERROR(RemoveTeammate(id));
   std::vector<std::unique_ptr<TeammateBlock>> ordered;
   for (int id : ids) {
-    auto it = std::find_if(teammates.begin(), teammates.end(),
-                           [id](const std::unique_ptr<TeammateBlock>& t) {
-                             return t != nullptr && t->id == id;
-                           });
+    auto it = std::find_if(
+        teammates.begin(), teammates.end(),
+        [id](const std::unique_ptr<TeammateBlock>& t) { return t != nullptr && t->id == id; });
     if (it != teammates.end()) {
       ordered.push_back(std::move(*it));
       continue;
@@ -329,9 +339,9 @@ Status WindowSmoother::Impl::SyncTeammates(const SwarmState& x_pred, const Eigen
 }
 
 Status WindowSmoother::Impl::AddTermsNaming(const WindowScan& s0, std::vector<double*>* kept) {
-  const StateKey leaving = StateKey::EgoAt(s0.stamp_ns);
+  const lio::StateKey leaving = lio::StateKey::EgoAt(s0.stamp_ns);
   for (const auto& s : scans) {
-    for (const OwnedResidualTerm& term : s->observations) {
+    for (const lio::OwnedResidualTerm& term : s->observations) {
       if (!Names(term, leaving)) continue;
       MarginalizationResidualBlock block;
       block.cost_function = term.cost.get();
@@ -348,16 +358,17 @@ Status WindowSmoother::Impl::AddTermsNaming(const WindowScan& s0, std::vector<do
 }
 
 void WindowSmoother::Impl::DropTermsNaming(WindowScan* s0) {
-  const StateKey leaving = StateKey::EgoAt(s0->stamp_ns);
+  const lio::StateKey leaving = lio::StateKey::EgoAt(s0->stamp_ns);
   for (size_t i = 1; i < scans.size(); ++i) {
     auto& obs = scans[i]->observations;
-    obs.erase(std::remove_if(obs.begin(), obs.end(),
-                             [&leaving](const OwnedResidualTerm& t) { return Names(t, leaving); }),
-              obs.end());
+    obs.erase(
+        std::remove_if(obs.begin(), obs.end(),
+                       [&leaving](const lio::OwnedResidualTerm& t) { return Names(t, leaving); }),
+        obs.end());
   }
   // A term of the leaving scan that does not name its state (teammate
   // blocks only) stays in the window, with the next state.
-  for (OwnedResidualTerm& term : s0->observations) {
+  for (lio::OwnedResidualTerm& term : s0->observations) {
     if (!Names(term, leaving)) scans[1]->observations.push_back(std::move(term));
   }
   s0->observations.clear();
@@ -380,11 +391,13 @@ Status WindowSmoother::Impl::MarginalizeOldest(std::vector<LeavingScan>* leaving
       {prior.factor.get(), nullptr, prior.system.parameter_blocks, prior.system.manifolds}));
   for (double* b : prior.system.parameter_blocks) keep(b);
   if (s0.HasPlaneInformation()) {
-    SWARMLIO_RETURN_IF_ERROR(
-        marginalizer->AddResidualBlock({&s0.compressed, nullptr, {s0.ego.data()}, {&ego_manifold}}));
+    SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(
+        {&s0.compressed, nullptr, {s0.ego.data()}, {&ego_manifold}}));
   }
-  SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock(
-      {s1.imu_factor.get(), nullptr, {s0.ego.data(), s1.ego.data()}, {&ego_manifold, &ego_manifold}}));
+  SWARMLIO_RETURN_IF_ERROR(marginalizer->AddResidualBlock({s1.imu_factor.get(),
+                                                           nullptr,
+                                                           {s0.ego.data(), s1.ego.data()},
+                                                           {&ego_manifold, &ego_manifold}}));
   // Every kept term on the leaving state, whichever scan took it over (a
   // term may name several window states: loop closures, relocalization).
   SWARMLIO_RETURN_IF_ERROR(AddTermsNaming(s0, &kept));
@@ -403,8 +416,10 @@ Status WindowSmoother::Impl::MarginalizeOldest(std::vector<LeavingScan>* leaving
   return Status::Ok();
 }
 
-Status WindowSmoother::AddState(WindowStateInput input, std::vector<LeavingScan>* leaving,
-                                double* marginalize_s, std::string* model_error) {
+Status WindowSmoother::AddState(WindowStateInput input,
+                                std::vector<LeavingScan>* leaving,
+                                double* marginalize_s,
+                                std::string* model_error) {
   Impl& im = *impl_;
   const Clock::time_point t0 = Clock::now();
   model_error->clear();
@@ -419,7 +434,8 @@ Status WindowSmoother::AddState(WindowStateInput input, std::vector<LeavingScan>
   return status;
 }
 
-Status WindowSmoother::Impl::AddState(WindowStateInput* in, std::vector<LeavingScan>* leaving,
+Status WindowSmoother::Impl::AddState(WindowStateInput* in,
+                                      std::vector<LeavingScan>* leaving,
                                       std::string* model_error) {
   Impl& im = *this;
   WindowStateInput& input = *in;
@@ -444,7 +460,7 @@ Status WindowSmoother::Impl::AddState(WindowStateInput* in, std::vector<LeavingS
   scan.points_in_b = std::move(input.points_in_b);
   scan.excluded = std::move(input.excluded);
   scan.use_planes = input.use_planes;
-  scan.associator = std::make_unique<ScanAssociator>(im.map, im.association);
+  scan.associator = std::make_unique<lio::ScanAssociator>(im.map, im.association);
   const Status observations = im.TakeObservations(&input, &scan);
   if (!observations.ok()) *model_error = observations.message();
   while (static_cast<int>(im.scans.size()) > im.options.size) {
@@ -465,4 +481,4 @@ void WindowSmoother::TakeScansForMap(std::vector<LeavingScan>* scans) {
   }
 }
 
-}  // namespace swarmlio::lio::internal
+}  // namespace swarmlio::window

@@ -14,12 +14,12 @@
 //     against the map at each outer iteration and handed to Ceres in
 //     information form (PoseInformationFactor, as the filter does);
 //   - the scan-stage hooks' residual terms (observations; any term naming
-//     window states by StateKey::EgoAt), taken over with the newest scan
+//     window states by lio::StateKey::EgoAt), taken over with the newest scan
 //     (Ego() rewritten to EgoAt(its stamp)) and kept until the first state
 //     they name is marginalized.
 // Per scan: AddState (the new state; the oldest beyond K is marginalized
 // and handed back for the map), then Solve (undamped Gauss-Newton, one Ceres
-// step per outer iteration, like EsikfUpdate), which returns the newest
+// step per outer iteration, like lio::EsikfUpdate), which returns the newest
 // state and its marginal covariance.
 #pragma once
 
@@ -40,45 +40,45 @@
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/state/swarm_state.h"
 
-namespace swarmlio::lio::internal {
+namespace swarmlio::window {
 
 /// A scan that left the window (or, at the end of a log, was flushed), with
 /// its final estimate, for the map.
 struct LeavingScan {
   EgoState state;
   std::vector<Eigen::Vector3d> points_in_b;  // undistorted, body frame at the scan end
-  std::vector<ExcludedRegion> excluded;
-  bool insert = false;  // updated by a solve and not in the map yet
+  std::vector<lio::ExcludedRegion> excluded;
+  bool insert = false;       // updated by a solve and not in the map yet
   std::vector<int> matched;  // points matched to a map plane at its last association
 };
 
 /// The newest scan state.
 struct WindowStateInput {
-  int64_t stamp_ns = 0;   // the state time (scan end)
-  SwarmState x_pred;      // the propagated prediction, teammate blocks included
-  Eigen::MatrixXd P_pred; // its covariance (prior of a (re)started window, new teammates)
-  std::vector<Eigen::Vector3d> points_in_b;  // undistorted scan
-  bool use_planes = false;                   // enough points for point-to-plane terms
-  std::vector<ExcludedRegion> excluded;      // kept out of the map
+  int64_t stamp_ns = 0;    // the state time (scan end)
+  SwarmState x_pred;       // the propagated prediction, teammate blocks included
+  Eigen::MatrixXd P_pred;  // its covariance (prior of a (re)started window, new teammates)
+  std::vector<Eigen::Vector3d> points_in_b;   // undistorted scan
+  bool use_planes = false;                    // enough points for point-to-plane terms
+  std::vector<lio::ExcludedRegion> excluded;  // kept out of the map
   /// The hooks' models of this scan: their terms are taken over
-  /// (MeasurementModel::ReleaseTerms) and stay with the scan's state.
-  std::vector<MeasurementModel*> models;
-  /// Teammates the filter would consider (UpdateRequest): the window holds
+  /// (lio::MeasurementModel::ReleaseTerms) and stay with the scan's state.
+  std::vector<lio::MeasurementModel*> models;
+  /// Teammates the filter would consider (lio::UpdateRequest): the window holds
   /// them at x_pred in this scan's terms (docs/window.md).
   std::vector<int> considered_teammates;
 };
 
 struct WindowSolveResult {
-  Status status;             // non-ok: the states keep their values before the solve
-  SwarmState state;          // newest state, teammates in x_pred's layout order
+  Status status;               // non-ok: the states keep their values before the solve
+  SwarmState state;            // newest state, teammates in x_pred's layout order
   Eigen::MatrixXd covariance;  // its marginal covariance (same layout)
-  bool updated = false;      // the newest scan's point-to-plane terms were in a successful solve
+  bool updated = false;        // the newest scan's point-to-plane terms were in a successful solve
   int iterations = 0;
   bool converged = false;
   int num_rejected_steps = 0;
   int num_correspondences = 0;  // newest scan, last iteration
   int num_residual_blocks = 0;  // measurement blocks (planes, observations) in the window
-  AssociationStats newest_stats;
+  lio::AssociationStats newest_stats;
   double build_s = 0.0;        // IMU re-integration, problem construction [s]
   double association_s = 0.0;  // every scan, every iteration [s]
   double solve_s = 0.0;        // ceres::Solve [s]
@@ -95,9 +95,12 @@ class WindowSmoother {
  public:
   /// InvalidArgument when the options do not validate. `map` must outlive
   /// the smoother; the odometry inserts the scans that leave.
-  static Status Create(const WindowOptions& options, const ImuPropagatorOptions& propagation,
-                       const ScanAssociationOptions& association, const EsikfUpdateOptions& update,
-                       const LocalMap* map, std::unique_ptr<WindowSmoother>* smoother);
+  static Status Create(const lio::WindowOptions& options,
+                       const lio::ImuPropagatorOptions& propagation,
+                       const lio::ScanAssociationOptions& association,
+                       const lio::EsikfUpdateOptions& update,
+                       const lio::LocalMap* map,
+                       std::unique_ptr<WindowSmoother>* smoother);
   ~WindowSmoother();
 
   /// The IMU interval from the newest state to the next one, fed with
@@ -105,8 +108,10 @@ class WindowSmoother {
   /// state's time with the propagator's last sample, AddImu per sample,
   /// IntegrateTo the scan end. Anything the preintegration refuses (a gap)
   /// breaks the interval: the next state restarts the window.
-  void StartInterval(int64_t stamp_ns, const ImuSample& last_sample,
-                     double acceleration_to_m_s2, const EgoState& newest);
+  void StartInterval(int64_t stamp_ns,
+                     const ImuSample& last_sample,
+                     double acceleration_to_m_s2,
+                     const EgoState& newest);
   void AddImu(const ImuSample& sample);
   void IntegrateTo(int64_t stamp_ns, const ImuSample* next_sample);
   void BreakInterval();
@@ -120,8 +125,10 @@ class WindowSmoother {
   /// none). An error (a prior that is not positive definite, a failed
   /// marginalization) empties the window into `*leaving`; the next state
   /// restarts it.
-  Status AddState(WindowStateInput input, std::vector<LeavingScan>* leaving,
-                  double* marginalize_s, std::string* model_error);
+  Status AddState(WindowStateInput input,
+                  std::vector<LeavingScan>* leaving,
+                  double* marginalize_s,
+                  std::string* model_error);
   /// The map was empty: the newest scan was inserted at its prediction and
   /// gets no point-to-plane terms (it built the map).
   void MarkNewestInMap();
@@ -141,4 +148,4 @@ class WindowSmoother {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace swarmlio::lio::internal
+}  // namespace swarmlio::window

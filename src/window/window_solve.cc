@@ -13,18 +13,18 @@
 #include "window_smoother.h"
 #include "window_state.h"
 
-namespace swarmlio::lio::internal {
+namespace swarmlio::window {
 namespace {
 
-ceres::LinearSolverType ToCeres(WindowLinearSolver solver) {
+ceres::LinearSolverType ToCeres(lio::WindowLinearSolver solver) {
   switch (solver) {
-    case WindowLinearSolver::kDenseQr:
+    case lio::WindowLinearSolver::kDenseQr:
       return ceres::DENSE_QR;
-    case WindowLinearSolver::kDenseSchur:
+    case lio::WindowLinearSolver::kDenseSchur:
       return ceres::DENSE_SCHUR;
-    case WindowLinearSolver::kSparseNormalCholesky:
+    case lio::WindowLinearSolver::kSparseNormalCholesky:
       return ceres::SPARSE_NORMAL_CHOLESKY;
-    case WindowLinearSolver::kDenseNormalCholesky:
+    case lio::WindowLinearSolver::kDenseNormalCholesky:
       break;
   }
   return ceres::DENSE_NORMAL_CHOLESKY;
@@ -32,9 +32,11 @@ ceres::LinearSolverType ToCeres(WindowLinearSolver solver) {
 
 // Adds J^T J of one residual block at the blocks' current values (tangent
 // Jacobians, factors/term_linearizer.h) to H at the blocks' offsets.
-bool AddBlockInformation(const ceres::CostFunction& cost, const std::vector<double*>& blocks,
+bool AddBlockInformation(const ceres::CostFunction& cost,
+                         const std::vector<double*>& blocks,
                          const std::vector<const ceres::Manifold*>& manifolds,
-                         const std::vector<int>& offsets, Eigen::MatrixXd* H) {
+                         const std::vector<int>& offsets,
+                         Eigen::MatrixXd* H) {
   const size_t nb = blocks.size();
   Eigen::VectorXd residuals;
   std::vector<Eigen::MatrixXd> tangent;
@@ -90,7 +92,8 @@ void WindowSmoother::Impl::Restore(const std::vector<double>& values) {
 void WindowSmoother::Impl::ReadState(SwarmState* x) const {
   *x = SwarmState();
   x->ego = scans.back()->State();
-  for (const auto& t : teammates) x->AddTeammate(t->id, GlobalExtrinsic::FromParameters(t->x.data()));
+  for (const auto& t : teammates)
+    x->AddTeammate(t->id, GlobalExtrinsic::FromParameters(t->x.data()));
 }
 
 Status WindowSmoother::Impl::NewestCovariance(Eigen::MatrixXd* P) const {
@@ -120,7 +123,7 @@ Status WindowSmoother::Impl::NewestCovariance(Eigen::MatrixXd* P) const {
       ok = ok && add(*s.imu_factor, {previous, ego}, {&ego_manifold, &ego_manifold});
     }
     if (s.HasPlaneInformation()) ok = ok && add(s.compressed, {ego}, {&ego_manifold});
-    for (const OwnedResidualTerm& term : s.observations) {
+    for (const lio::OwnedResidualTerm& term : s.observations) {
       std::vector<double*> blocks;
       std::vector<const ceres::Manifold*> manifolds;
       BlocksOf(term, &blocks, &manifolds);
@@ -174,7 +177,7 @@ int WindowSmoother::Impl::AddResidualBlocks(const std::vector<WindowScan*>& acti
   for (WindowScan* s : active) problem->AddResidualBlock(&s->compressed, nullptr, s->ego.data());
   int num_measurement_blocks = 0;
   for (auto& s : scans) {
-    for (const OwnedResidualTerm& term : s->observations) {
+    for (const lio::OwnedResidualTerm& term : s->observations) {
       std::vector<double*> blocks;
       BlocksOf(term, &blocks, nullptr);
       problem->AddResidualBlock(term.cost.get(), nullptr, blocks);
@@ -226,7 +229,8 @@ void WindowSmoother::Impl::Iterate(const std::vector<WindowScan*>& active,
                                    const std::vector<WindowScan*>& associated,
                                    ceres::Problem* problem,
                                    WindowSolveResult* result) {
-  ceres::Solver::Options solver_options = GaussNewtonStepOptions(ToCeres(options.linear_solver));
+  ceres::Solver::Options solver_options =
+      lio::GaussNewtonStepOptions(ToCeres(options.linear_solver));
   solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   for (int it = 0; it < options.max_iterations; ++it) {
     const Clock::time_point t_assoc = Clock::now();
@@ -311,4 +315,4 @@ WindowSolveResult WindowSmoother::Solve() {
   return result;
 }
 
-}  // namespace swarmlio::lio::internal
+}  // namespace swarmlio::window

@@ -27,7 +27,7 @@
 #include "swarmlio/window/marginalization.h"
 #include "window_smoother.h"
 
-namespace swarmlio::lio::internal {
+namespace swarmlio::window {
 
 using Clock = std::chrono::steady_clock;
 using EgoParameters = std::array<double, EgoState::kAmbientSize>;
@@ -40,20 +40,20 @@ struct WindowScan {
   int64_t stamp_ns = 0;
   EgoParameters ego{};
   std::vector<Eigen::Vector3d> points_in_b;
-  std::vector<ExcludedRegion> excluded;
+  std::vector<lio::ExcludedRegion> excluded;
   bool use_planes = false;  // enough points
   bool in_map = false;      // its points are in the map (it built the map, or was flushed)
   bool updated = false;     // its planes were in a successful solve
-  std::unique_ptr<ScanAssociator> associator;
+  std::unique_ptr<lio::ScanAssociator> associator;
   std::vector<PlaneCorrespondence> correspondences;  // of the last association
   PointToPlaneFactor planes{&correspondences};       // the point rows (normal equations)
   PoseInformationFactor compressed;                  // what Ceres and the marginalizer see
-  AssociationStats stats;
-  std::unique_ptr<ImuPreintegration> imu;  // from the previous state (none for the first)
+  lio::AssociationStats stats;
+  std::unique_ptr<lio::ImuPreintegration> imu;  // from the previous state (none for the first)
   std::unique_ptr<ImuPreintegrationFactor> imu_factor;
   // The hooks' terms taken over with this scan, every ego key an EgoAt (Ego()
   // rewritten to this scan's stamp); they may name earlier states too.
-  std::vector<OwnedResidualTerm> observations;
+  std::vector<lio::OwnedResidualTerm> observations;
 
   EgoState State() const { return EgoState::FromParameters(ego.data()); }
   // The plane information of a successful solve, linearized at the current value.
@@ -88,12 +88,12 @@ struct Prior {
 };
 
 struct WindowSmoother::Impl {
-  WindowOptions options;
-  ImuPreintegrationOptions preintegration;
-  ProcessNoiseOptions process_noise;  // the propagator's (teammate random walks)
-  ScanAssociationOptions association;
-  EsikfUpdateOptions update;
-  const LocalMap* map = nullptr;
+  lio::WindowOptions options;
+  lio::ImuPreintegrationOptions preintegration;
+  lio::ProcessNoiseOptions process_noise;  // the propagator's (teammate random walks)
+  lio::ScanAssociationOptions association;
+  lio::EsikfUpdateOptions update;
+  const lio::LocalMap* map = nullptr;
   EgoStateManifold ego_manifold;
   GlobalExtrinsicManifold teammate_manifold;
   MarginalizationPriorFactorOptions prior_options;
@@ -101,7 +101,7 @@ struct WindowSmoother::Impl {
   std::deque<std::unique_ptr<WindowScan>> scans;
   std::vector<std::unique_ptr<TeammateBlock>> teammates;  // the newest prediction's layout order
   Prior prior;  // factor == nullptr only while the window is empty
-  std::unique_ptr<ImuPreintegration> interval;  // being integrated towards the next state
+  std::unique_ptr<lio::ImuPreintegration> interval;  // being integrated towards the next state
   bool interval_ok = false;
   WindowCounters counters;
 
@@ -117,7 +117,8 @@ struct WindowSmoother::Impl {
                           const std::vector<const ceres::Manifold*>& manifolds,
                           const Eigen::MatrixXd& covariance);
   // Appends an independent block N(current value, covariance) to the prior.
-  Status ExtendPrior(double* block, const ceres::Manifold* manifold,
+  Status ExtendPrior(double* block,
+                     const ceres::Manifold* manifold,
                      const Eigen::MatrixXd& covariance);
   // The teammates' random walk over an interval (the propagator's process
   // noise, sum_dt2 = sum of the squared IMU steps) added to a prior's
@@ -138,9 +139,10 @@ struct WindowSmoother::Impl {
   // Checks a term handed over with the scan at `stamp_ns` and rewrites its
   // Ego() keys to EgoAt(stamp_ns): every key must name a block the window
   // holds, with the cost's block size; the error names the model and key.
-  Status AdoptTerm(int64_t stamp_ns, const char* model, OwnedResidualTerm* term) const;
+  Status AdoptTerm(int64_t stamp_ns, const char* model, lio::OwnedResidualTerm* term) const;
   Status TakeObservations(WindowStateInput* input, WindowScan* scan);
-  Status AddState(WindowStateInput* input, std::vector<LeavingScan>* leaving,
+  Status AddState(WindowStateInput* input,
+                  std::vector<LeavingScan>* leaving,
                   std::string* model_error);
   void ReintegrateImu();
   // Solve, step by step (window_solve.cc). The scans with point-to-plane
@@ -182,31 +184,31 @@ struct WindowSmoother::Impl {
   // The parameter block a key of a kept term names (EgoAt(t): the window
   // state at t; Extrinsic(id): the teammate block); nullptr when the window
   // does not hold it (and for Ego(), which no kept term holds).
-  double* BlockOf(const StateKey& key) const {
+  double* BlockOf(const lio::StateKey& key) const {
     switch (key.kind()) {
-      case StateKey::Kind::kEgoAt: {
+      case lio::StateKey::Kind::kEgoAt: {
         WindowScan* s = ScanAt(key.stamp_ns());
         return s == nullptr ? nullptr : s->ego.data();
       }
-      case StateKey::Kind::kTeammateExtrinsic:
+      case lio::StateKey::Kind::kTeammateExtrinsic:
         return Teammate(key.teammate_id());
-      case StateKey::Kind::kEgo:
+      case lio::StateKey::Kind::kEgo:
         break;
     }
     return nullptr;
   }
-  const ceres::Manifold* ManifoldOf(const StateKey& key) const {
-    return key.is_ego() ? static_cast<const ceres::Manifold*>(&ego_manifold)
-                        : &teammate_manifold;
+  const ceres::Manifold* ManifoldOf(const lio::StateKey& key) const {
+    return key.is_ego() ? static_cast<const ceres::Manifold*>(&ego_manifold) : &teammate_manifold;
   }
   // A kept term's parameter blocks and manifolds, in its key order.
-  void BlocksOf(const OwnedResidualTerm& term, std::vector<double*>* blocks,
+  void BlocksOf(const lio::OwnedResidualTerm& term,
+                std::vector<double*>* blocks,
                 std::vector<const ceres::Manifold*>* manifolds) const {
-    for (const StateKey& key : term.blocks) {
+    for (const lio::StateKey& key : term.blocks) {
       blocks->push_back(BlockOf(key));
       if (manifolds != nullptr) manifolds->push_back(ManifoldOf(key));
     }
   }
 };
 
-}  // namespace swarmlio::lio::internal
+}  // namespace swarmlio::window

@@ -3,7 +3,7 @@
 // invalid blocks and non-finite linearizations (docs/window.md).
 #include "marginalization_test_util.h"
 
-namespace swarmlio::marginalization_test {
+namespace swarmlio::window::marginalization_test {
 namespace {
 
 class LinearCost final : public ceres::CostFunction {
@@ -244,4 +244,4 @@ TEST(MarginalizationPriorFactor, CreateRejectsInvalidPriors) {
 }
 
 }  // namespace
-}  // namespace swarmlio::marginalization_test
+}  // namespace swarmlio::window::marginalization_test

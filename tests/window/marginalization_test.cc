@@ -15,7 +15,7 @@
 // Status errors.
 #include "marginalization_test_util.h"
 
-namespace swarmlio::marginalization_test {
+namespace swarmlio::window::marginalization_test {
 namespace {
 
 TEST(Marginalizer, PriorEqualsTheDenseGaussianMarginal) {
@@ -240,4 +240,4 @@ TEST(MarginalizationPriorFactor, CostAtTheLinearizationPointIsTheEliminatedConst
 // A linear residual sum_i A_i x_i + c over Euclidean blocks.
 
 }  // namespace
-}  // namespace swarmlio::marginalization_test
+}  // namespace swarmlio::window::marginalization_test

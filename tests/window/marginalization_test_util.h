@@ -4,8 +4,6 @@
 // linearized by Ceres itself, and the dense reference computations.
 #pragma once
 
-#include "swarmlio/window/marginalization.h"
-
 #include <ceres/crs_matrix.h>
 #include <ceres/loss_function.h>
 #include <ceres/manifold.h>
@@ -34,8 +32,9 @@
 #include "factors/prior_factor.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/testing/jacobian_check.h"
+#include "swarmlio/window/marginalization.h"
 
-namespace swarmlio::marginalization_test {
+namespace swarmlio::window::marginalization_test {
 
 inline constexpr double kTolerance = 1e-9;  // relative, (a) and (b)
 
@@ -321,9 +320,9 @@ class Window {
 };
 
 inline Status Marginalize(const std::vector<Term>& terms,
-                   const std::vector<double*>& marginalized,
-                   const std::vector<double*>& kept,
-                   MarginalizationPrior* prior) {
+                          const std::vector<double*>& marginalized,
+                          const std::vector<double*>& kept,
+                          MarginalizationPrior* prior) {
   std::unique_ptr<Marginalizer> marginalizer;
   SWARMLIO_RETURN_IF_ERROR(Marginalizer::Create(MarginalizationOptions(), &marginalizer));
   for (const Term& t : terms) {
@@ -337,7 +336,8 @@ inline Status Marginalize(const std::vector<Term>& terms,
   return marginalizer->Marginalize(marginalized, kept, prior);
 }
 
-inline std::unique_ptr<MarginalizationPriorFactor> PriorFactorOf(const MarginalizationPrior& prior) {
+inline std::unique_ptr<MarginalizationPriorFactor> PriorFactorOf(
+    const MarginalizationPrior& prior) {
   std::unique_ptr<MarginalizationPriorFactor> factor;
   const Status status =
       MarginalizationPriorFactor::Create(prior, MarginalizationPriorFactorOptions(), &factor);
@@ -352,9 +352,9 @@ struct Case {
   bool with_losses;
 };
 inline const Case kCases[] = {{"x0", false, false},
-                       {"x0 with losses", false, true},
-                       {"x0 and T", true, false},
-                       {"x0 and T with losses", true, true}};
+                              {"x0 with losses", false, true},
+                              {"x0 and T", true, false},
+                              {"x0 and T with losses", true, true}};
 
 struct Split {
   std::vector<double*> marginalized, kept;
@@ -371,4 +371,4 @@ inline Split SplitOf(Window* w, const Case& c) {
 // dense inverse; a known unit information R on the kept blocks is then added
 // to both sides (the Schur complement of H + R_kk is H* + R_kk, with the same b*).
 
-}  // namespace swarmlio::marginalization_test
+}  // namespace swarmlio::window::marginalization_test

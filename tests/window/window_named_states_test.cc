@@ -1,6 +1,6 @@
-// The fixed-lag window and named states (StateKey, docs/architecture.md
+// The fixed-lag window and named states (lio::StateKey, docs/architecture.md
 // "Named states", docs/window.md "The window"): a relative-pose term between
-// two window states, named StateKey::EgoAt(stamp), handed to the window with
+// two window states, named lio::StateKey::EgoAt(stamp), handed to the window with
 // the newest scan like the component's observations.
 //
 // The seam is WindowSmoother itself (internal to swarmlio_lio, driven here
@@ -24,7 +24,7 @@
 #include "src/window/window_smoother.h"
 #include "swarmlio/lio/state_key.h"
 
-namespace swarmlio::lio::internal {
+namespace swarmlio::window {
 namespace {
 
 constexpr int64_t kT0Ns = 1'000'000'000;
@@ -36,18 +36,18 @@ int64_t ScanEnd(int k) { return kT0Ns + k * kScanPeriodNs; }
 
 // A model whose terms the window takes over (as the component's mutual
 // observations); the window never linearizes it.
-class KeptTerms final : public MeasurementModel {
+class KeptTerms final : public lio::MeasurementModel {
  public:
   const char* name() const override { return "loop_closure"; }
-  Status Linearize(const SwarmState&, std::vector<ResidualTerm>*) override {
+  Status Linearize(const SwarmState&, std::vector<lio::ResidualTerm>*) override {
     return Status::FailedPrecondition("a window-only model");
   }
-  bool ReleaseTerms(std::vector<OwnedResidualTerm>* terms) override {
-    for (OwnedResidualTerm& t : terms_) terms->push_back(std::move(t));
+  bool ReleaseTerms(std::vector<lio::OwnedResidualTerm>* terms) override {
+    for (lio::OwnedResidualTerm& t : terms_) terms->push_back(std::move(t));
     terms_.clear();
     return true;
   }
-  std::vector<OwnedResidualTerm> terms_;
+  std::vector<lio::OwnedResidualTerm> terms_;
 };
 
 // The measured pose of the body at t2 in the body at t0: 5 cm along x.
@@ -76,7 +76,7 @@ ImuSample Sample(int64_t stamp_ns) {
 
 class FloorWindow {
  public:
-  explicit FloorWindow(int size) : map_(LocalMapOptions()) {
+  explicit FloorWindow(int size) : map_(lio::LocalMapOptions()) {
     std::vector<Eigen::Vector3d> floor_in_G;
     for (double x = -8.0; x <= 8.0; x += 0.25) {
       for (double y = -8.0; y <= 8.0; y += 0.25) floor_in_G.emplace_back(x, y, 0.0);
@@ -85,13 +85,13 @@ class FloorWindow {
     for (double x = -5.0; x <= 5.0; x += 0.5) {
       for (double y = -5.0; y <= 5.0; y += 0.5) floor_in_b_.emplace_back(x, y, -1.0);
     }
-    WindowOptions options;
+    lio::WindowOptions options;
     options.size = size;
-    ScanAssociationOptions association;
+    lio::ScanAssociationOptions association;
     association.max_normal_stddev_rad = 0.0;  // a floor: no noisy-plane handling
     association.tilt_projection_sigma = 0.0;
-    status_ = WindowSmoother::Create(options, ImuPropagatorOptions(), association,
-                                     EsikfUpdateOptions(), &map_, &window_);
+    status_ = WindowSmoother::Create(options, lio::ImuPropagatorOptions(), association,
+                                     lio::EsikfUpdateOptions(), &map_, &window_);
   }
 
   // Adds the state at scan end k (IMU at rest since the previous state,
@@ -99,7 +99,7 @@ class FloorWindow {
   Status Add(int k,
              const EgoState& previous,
              const EgoState& x_pred,
-             std::vector<MeasurementModel*> models,
+             std::vector<lio::MeasurementModel*> models,
              std::string* model_error) {
     if (k > 0) {
       window_->StartInterval(ScanEnd(k - 1), Sample(ScanEnd(k - 1)), 1.0, previous);
@@ -129,7 +129,7 @@ class FloorWindow {
   const std::vector<LeavingScan>& leaving() const { return leaving_; }
 
  private:
-  LocalMap map_;
+  lio::LocalMap map_;
   std::vector<Eigen::Vector3d> floor_in_b_;
   std::unique_ptr<WindowSmoother> window_;
   std::vector<LeavingScan> leaving_;
@@ -148,7 +148,8 @@ std::vector<EgoState> SolveThreeStates(bool with_term, const RelativePoseFactor*
     if (k == 2 && with_term) {
       std::unique_ptr<RelativePoseFactor> cost = LoopClosure();
       *factor = cost.get();
-      loop.terms_.push_back({std::move(cost), {StateKey::EgoAt(ScanEnd(0)), StateKey::Ego()}});
+      loop.terms_.push_back(
+          {std::move(cost), {lio::StateKey::EgoAt(ScanEnd(0)), lio::StateKey::Ego()}});
     }
     EXPECT_TRUE(w.Add(k, newest, AtRest(0.0, 0.0), {&loop}, &model_error).ok());
     EXPECT_EQ(model_error, "");
@@ -203,7 +204,8 @@ TEST(WindowNamedStates, TheTermMovesIntoThePriorWhenItsFirstStateLeaves) {
   for (int k = 0; k < 5; ++k) {
     KeptTerms loop;
     if (k == 2) {
-      loop.terms_.push_back({LoopClosure(), {StateKey::EgoAt(ScanEnd(0)), StateKey::Ego()}});
+      loop.terms_.push_back(
+          {LoopClosure(), {lio::StateKey::EgoAt(ScanEnd(0)), lio::StateKey::Ego()}});
     }
     // The prediction of a constant-velocity propagation from the newest estimate.
     const EgoState x_pred =
@@ -243,10 +245,10 @@ TEST(WindowNamedStates, AKeyNamingAStateNotInTheWindowIsRefused) {
   for (int64_t stamp_ns : {marginalized_ns, never_ns}) {
     SCOPED_TRACE(stamp_ns);
     KeptTerms loop;
-    loop.terms_.push_back({LoopClosure(), {StateKey::EgoAt(stamp_ns), StateKey::Ego()}});
+    loop.terms_.push_back({LoopClosure(), {lio::StateKey::EgoAt(stamp_ns), lio::StateKey::Ego()}});
     const int k = stamp_ns == marginalized_ns ? 3 : 4;
     EXPECT_TRUE(w.Add(k, newest, AtRest(0.0, 0.0), {&loop}, &model_error).ok());
-    EXPECT_NE(model_error.find("loop_closure names " + StateKey::EgoAt(stamp_ns).ToString() +
+    EXPECT_NE(model_error.find("loop_closure names " + lio::StateKey::EgoAt(stamp_ns).ToString() +
                                ", which the window does not hold"),
               std::string::npos)
         << model_error;
@@ -259,10 +261,10 @@ TEST(WindowNamedStates, AKeyNamingAStateNotInTheWindowIsRefused) {
   // A state in the window is accepted (t4: the window holds t3, t4, t5 while
   // it takes t5's terms, then marginalizes t3).
   KeptTerms loop;
-  loop.terms_.push_back({LoopClosure(), {StateKey::EgoAt(ScanEnd(4)), StateKey::Ego()}});
+  loop.terms_.push_back({LoopClosure(), {lio::StateKey::EgoAt(ScanEnd(4)), lio::StateKey::Ego()}});
   EXPECT_TRUE(w.Add(5, newest, AtRest(0.0, 0.0), {&loop}, &model_error).ok());
   EXPECT_EQ(model_error, "");
 }
 
 }  // namespace
-}  // namespace swarmlio::lio::internal
+}  // namespace swarmlio::window

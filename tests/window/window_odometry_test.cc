@@ -45,8 +45,8 @@ class LockstepSink : public sim::DroneSink {
       : outputs(odometries.size()), odometries_(std::move(odometries)) {}
   Status OnImu(const ImuSample& imu) override {
     for (lio::Odometry* o : odometries_) {
-      if (const Status s = o->AddImu(imu); s.code() != Status::Code::kOk &&
-                                           s.code() != Status::Code::kInvalidArgument) {
+      if (const Status s = o->AddImu(imu);
+          s.code() != Status::Code::kOk && s.code() != Status::Code::kInvalidArgument) {
         return s;
       }
     }
@@ -54,8 +54,8 @@ class LockstepSink : public sim::DroneSink {
   }
   Status OnScan(const LidarScan& scan, int64_t) override {
     for (lio::Odometry* o : odometries_) {
-      if (const Status s = o->AddScan(scan); s.code() != Status::Code::kOk &&
-                                             s.code() != Status::Code::kInvalidArgument) {
+      if (const Status s = o->AddScan(scan);
+          s.code() != Status::Code::kOk && s.code() != Status::Code::kInvalidArgument) {
         return s;
       }
     }
@@ -90,10 +90,10 @@ struct Simulation {
 // indoor_3uav: 4 s static, take-off, excitation.
 Simulation Indoor(double duration_s) {
   sim::Scenario scenario;
-  EXPECT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
-                                    "/configs/scenarios/indoor_3uav.yaml",
-                                &scenario)
-                  .ok());
+  EXPECT_TRUE(
+      sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml",
+                        &scenario)
+          .ok());
   sim::SimulationConfig config = scenario.simulation_config();
   config.duration_s = duration_s;
   config.num_threads = 1;
@@ -119,12 +119,12 @@ TEST(WindowOdometry, WindowOfOneReproducesTheFilter) {
     const sim::DroneConfig& d = sim.drones[static_cast<size_t>(drone)];
     SCOPED_TRACE(d.name);
     std::unique_ptr<lio::Odometry> filter, window;
-    ASSERT_TRUE(lio::Odometry::Create(Options(d, lio::EstimatorKind::kFilter, 1), d.lidar.sensor,
-                                      &filter)
-                    .ok());
-    ASSERT_TRUE(lio::Odometry::Create(Options(d, lio::EstimatorKind::kWindow, 1), d.lidar.sensor,
-                                      &window)
-                    .ok());
+    ASSERT_TRUE(
+        lio::Odometry::Create(Options(d, lio::EstimatorKind::kFilter, 1), d.lidar.sensor, &filter)
+            .ok());
+    ASSERT_TRUE(
+        lio::Odometry::Create(Options(d, lio::EstimatorKind::kWindow, 1), d.lidar.sensor, &window)
+            .ok());
     LockstepSink sink({filter.get(), window.get()});
     sim::DroneStats stats;
     ASSERT_TRUE(sim.simulator->RunDrone(drone, &sink, &stats).ok());
@@ -162,9 +162,10 @@ TEST(WindowOdometry, WindowOfOneReproducesTheFilter) {
     EXPECT_GE(updated, static_cast<int>(w.size()) - 1);
     EXPECT_LT(max_dsigma_rel, 1e-5);  // measured 1.5e-6
     EXPECT_EQ(filter->map_size(), window->map_size());
-    std::printf("[ figures  ] %s, %zu scans: K = 1 vs filter: max |dp| %.2e m, max |dtheta| "
-                "%.2e deg, max relative position-sigma difference %.2e\n",
-                d.name.c_str(), w.size(), max_dp, max_dtheta_deg, max_dsigma_rel);
+    std::printf(
+        "[ figures  ] %s, %zu scans: K = 1 vs filter: max |dp| %.2e m, max |dtheta| "
+        "%.2e deg, max relative position-sigma difference %.2e\n",
+        d.name.c_str(), w.size(), max_dp, max_dtheta_deg, max_dsigma_rel);
   }
 }
 
@@ -195,10 +196,11 @@ TEST(WindowOdometry, WindowOfFiveTracksAShortIndoorFlight) {
                                           eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
                                           &consistency)
                     .ok());
-    std::printf("[ figures  ] %s, %s: position RMSE %.4f m, rotation RMSE %.3f deg, mean "
-                "position NEES %.2f\n",
-                d.name.c_str(), name, consistency.position_rmse_m, consistency.rotation_rmse_deg,
-                consistency.mean_position_nees);
+    std::printf(
+        "[ figures  ] %s, %s: position RMSE %.4f m, rotation RMSE %.3f deg, mean "
+        "position NEES %.2f\n",
+        d.name.c_str(), name, consistency.position_rmse_m, consistency.rotation_rmse_deg,
+        consistency.mean_position_nees);
     EXPECT_LT(consistency.position_rmse_m, 0.02);
     EXPECT_LT(consistency.rotation_rmse_deg, 1.0);
     // Measured 0.59 (filter) and 0.71 (window), Release, session 18: 3x
@@ -232,13 +234,16 @@ TEST(WindowOdometry, ManifestKeysSelectTheWindow) {
       "drones:\n"
       "  - name: a\n"
       "    bag: a.bag\n"
-      "    sensor_preset: " + presets + "livox_mid360.yaml\n"
+      "    sensor_preset: " +
+      presets +
+      "livox_mid360.yaml\n"
       "    odometry: {estimator: window,\n"
       "               window: {size: 7, experimental: {linear_solver: sparse_normal_cholesky,\n"
       "                                                reassociate_all_scans: false}}}\n"
       "  - name: b\n"
       "    bag: b.bag\n"
-      "    sensor_preset: " + presets + "livox_avia.yaml\n";
+      "    sensor_preset: " +
+      presets + "livox_avia.yaml\n";
   driver::SwarmManifest m;
   const Status status = driver::ParseManifest(yaml, "/data/swarm.yaml", &m);
   ASSERT_TRUE(status.ok()) << status.message();

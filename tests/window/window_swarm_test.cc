@@ -40,8 +40,8 @@ class WindowSwarmTest : public ::testing::Test {
     fs::create_directories(*dir_);
     manifest_ = new driver::SwarmManifest();
     ASSERT_TRUE(swarmlio::testing::SimulateSwarm(
-        std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "indoor_3uav", 22.0, *dir_,
-        manifest_));
+        std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", "indoor_3uav",
+        22.0, *dir_, manifest_));
   }
   static void TearDownTestSuite() {
     std::error_code ec;
@@ -71,7 +71,8 @@ class WindowSwarmTest : public ::testing::Test {
                       .ok());
       r.position_rmse_m = c.position_rmse_m;
       r.identified = static_cast<int>(d.identifications().size());
-      for (const swarm::DroneOutput& s : d.scans()) r.fused += s.active_observations + s.passive_observations;
+      for (const swarm::DroneOutput& s : d.scans())
+        r.fused += s.active_observations + s.passive_observations;
       out.push_back(std::move(r));
     }
     return out;
@@ -130,14 +131,16 @@ TEST_F(WindowSwarmTest, WindowFusesTheTeammatesAndEqualsTheFilterAtOneState) {
     double max_dp = 0.0;
     for (size_t k = 0; k < filter[i].scans.size(); ++k) {
       max_dp = std::max(
-          max_dp, (filter[i].scans[k].ego.state.p_b_in_G - one[i].scans[k].ego.state.p_b_in_G).norm());
+          max_dp,
+          (filter[i].scans[k].ego.state.p_b_in_G - one[i].scans[k].ego.state.p_b_in_G).norm());
     }
     double max_dT_m = 0.0, max_dT_deg = 0.0;
     ExtrinsicDifference(filter[i], one[i], &max_dT_m, &max_dT_deg);
-    std::printf("[ figures  ] %s: K = 1 vs filter in the swarm: max |dp| %.2e m, extrinsics max "
-                "%.2e m / %.3f deg; observations fused %d / %d\n",
-                manifest_->drones[i].name.c_str(), max_dp, max_dT_m, max_dT_deg, one[i].fused,
-                filter[i].fused);
+    std::printf(
+        "[ figures  ] %s: K = 1 vs filter in the swarm: max |dp| %.2e m, extrinsics max "
+        "%.2e m / %.3f deg; observations fused %d / %d\n",
+        manifest_->drones[i].name.c_str(), max_dp, max_dT_m, max_dT_deg, one[i].fused,
+        filter[i].fused);
     EXPECT_EQ(one[i].identified, 2);
     EXPECT_GT(one[i].fused, 100);
     EXPECT_LT(max_dp, 5e-3);
@@ -145,10 +148,11 @@ TEST_F(WindowSwarmTest, WindowFusesTheTeammatesAndEqualsTheFilterAtOneState) {
     EXPECT_LT(max_dT_deg, 0.2);
 
     ExtrinsicDifference(filter[i], five[i], &max_dT_m, &max_dT_deg);
-    std::printf("[ figures  ] %s: K = 5: position RMSE %.4f m (filter %.4f m), extrinsics vs "
-                "the filter's max %.3f m / %.2f deg, observations fused %d\n",
-                manifest_->drones[i].name.c_str(), five[i].position_rmse_m,
-                filter[i].position_rmse_m, max_dT_m, max_dT_deg, five[i].fused);
+    std::printf(
+        "[ figures  ] %s: K = 5: position RMSE %.4f m (filter %.4f m), extrinsics vs "
+        "the filter's max %.3f m / %.2f deg, observations fused %d\n",
+        manifest_->drones[i].name.c_str(), five[i].position_rmse_m, filter[i].position_rmse_m,
+        max_dT_m, max_dT_deg, five[i].fused);
     EXPECT_EQ(five[i].identified, 2);
     EXPECT_GT(five[i].fused, 100);
     EXPECT_LT(five[i].position_rmse_m, 1.5 * filter[i].position_rmse_m + 0.002);

@@ -79,7 +79,7 @@ struct WindowOptions {
   /// ... or its accelerometer bias this far [m/s^2].
   double reintegrate_accel_bias_m_s2 = 0.05;
   /// Schur complement of the states that leave the window.
-  MarginalizationOptions marginalization;
+  window::MarginalizationOptions marginalization;
 
   template <class V>
   void VisitFields(V&& v) {

@@ -45,7 +45,7 @@
 #include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
 
-namespace swarmlio {
+namespace swarmlio::window {
 
 struct MarginalizationOptions {
   /// Eigenvalues of H_mm at or below this fraction of its largest eigenvalue
@@ -114,4 +114,4 @@ class Marginalizer {
   std::vector<MarginalizationResidualBlock> residual_blocks_;
 };
 
-}  // namespace swarmlio
+}  // namespace swarmlio::window
