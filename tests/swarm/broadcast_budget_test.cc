@@ -163,7 +163,7 @@ TEST(DroneEstimator, KeepsItsBroadcastWithinTheByteBudget) {
     run.sink->mutual_at_s = 9.0;  // identified then; observations from then on
     ASSERT_TRUE(run.Run());
     ASSERT_EQ(run.sink->ego_states_sent, static_cast<int>(run.sink->outputs.size()));
-    EXPECT_EQ(run.estimator->counters().identifications, 1) << rate;
+    EXPECT_EQ(run.estimator().counters().identifications, 1) << rate;
     sent[rate] = Sent{run.sink->wire_bytes, run.sink->observations_sent};
   }
   const Sent& unlimited = sent.at(0.0);

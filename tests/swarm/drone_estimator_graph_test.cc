@@ -16,7 +16,6 @@ namespace {
 using test_support::IndoorScenario;
 using test_support::ObserverRun;
 using test_support::ObserverSink;
-using test_support::OptionsFor;
 using test_support::ToIsometry;
 
 // The chain case of a restart (docs/swarm.md "Identification through
@@ -41,13 +40,10 @@ struct ChainResult {
 ChainResult RunRestartChain(bool graph_through_derived, bool relayed_sends_derived) {
   sim::Scenario scenario = IndoorScenario();
   const int observer = 0, teammate = 1, relayed = 2;
-  ObserverRun run(std::move(scenario), 14.0, observer, teammate);
-  DroneEstimatorOptions options = OptionsFor(run.drones[observer]);
-  options.swarm.graph_through_derived = graph_through_derived;
-  EXPECT_TRUE(DroneEstimator::Create(observer, options, run.drones[observer].lidar.sensor,
-                                     &run.estimator)
-                  .ok());
-  run.sink = std::make_unique<ObserverSink>(*run.simulator, observer, teammate, run.estimator.get());
+  ObserverRun run(std::move(scenario), 14.0, observer, teammate,
+                  [graph_through_derived](DroneEstimatorOptions* o) {
+                    o->swarm.graph_through_derived = graph_through_derived;
+                  });
   ObserverSink& sink = *run.sink;
   sink.mutual_at_s = 10.0;
   sink.relayed_id = relayed;

@@ -1,14 +1,16 @@
-// swarm::DroneEstimator driven directly (no bag, no replay): one simulated
-// drone of indoor_3uav feeds the component with its IMU and LiDAR, and a
-// teammate's broadcasts are made from the simulator's truth (its state in
-// its own G_j, stamps in the observer's clock, 20 ms latency, every scan; each
-// with the teammate's observation of the observer, 2 cm noise). The component
-// must identify the teammate, add its T_Gi_Gj block, fuse active and passive
-// observations, estimate T_Gi_Gj to a few centimetres, keep the ego estimate
-// accurate, and drop the block when the teammate reboots (new session).
-// Plus the input checks. The byte budget's test is in broadcast_budget_test.cc,
-// the restart chain's in drone_estimator_graph_test.cc; the drone and the
-// teammate's broadcasts are observer_run.h's.
+// swarm::DroneEstimator without a bag or the replay: one simulated drone of
+// indoor_3uav feeds the component with its IMU and LiDAR through
+// driver::DroneDriver, and a teammate's broadcasts are made from the
+// simulator's truth (its state in its own G_j, stamps in the observer's
+// clock, 20 ms latency, every scan; each with the teammate's observation of
+// the observer, 2 cm noise). The component must identify the teammate, add
+// its T_Gi_Gj block, fuse active and passive observations, estimate T_Gi_Gj
+// to a few centimetres, keep the ego estimate accurate, and drop the block
+// when the teammate reboots (new session). Plus the input checks, which call
+// the component's own entry (DroneEstimator::Add, PopMessages) without a
+// driver. The byte budget's test is in broadcast_budget_test.cc, the restart
+// chain's in drone_estimator_graph_test.cc; the drone and the teammate's
+// broadcasts are observer_run.h's.
 #include "swarmlio/swarm/drone_estimator.h"
 
 #include <gtest/gtest.h>
@@ -50,6 +52,8 @@ TEST(DroneEstimator, RejectsInvalidOptionsAndIds) {
       << status.message();
 }
 
+// The component's own entry, DroneEstimator::Add, on purpose (no driver):
+// its answer to each bad message.
 TEST(DroneEstimator, IgnoresOwnForeignTypedAndNonFiniteMessages) {
   sim::Scenario scenario = IndoorScenario();
   ASSERT_FALSE(scenario.drones.empty());
@@ -60,15 +64,15 @@ TEST(DroneEstimator, IgnoresOwnForeignTypedAndNonFiniteMessages) {
   net::EgoStateMessage m;
   m.sender_id = 0;
   own.message = m;
-  EXPECT_TRUE(e->AddMessage(own).ok());
+  EXPECT_TRUE(e->Add(own).ok());
   net::ReceivedMessage nan;
   m.sender_id = 1;
   m.p_bj_in_Gj.x() = std::nan("");
   nan.message = m;
-  EXPECT_TRUE(e->AddMessage(nan).ok());
+  EXPECT_TRUE(e->Add(nan).ok());
   net::ReceivedMessage sync;
   sync.message = net::TimeSyncMessage();
-  EXPECT_TRUE(e->AddMessage(sync).ok());
+  EXPECT_TRUE(e->Add(sync).ok());
   EXPECT_EQ(e->counters().messages_received, 3);
   EXPECT_EQ(e->counters().messages_ignored, 3);
 }
@@ -76,6 +80,8 @@ TEST(DroneEstimator, IgnoresOwnForeignTypedAndNonFiniteMessages) {
 // A teammate's states wait for its clock offset; with exchange = requests the
 // TimeSync requests and answers leave with the send time (the newest sensor
 // stamp). (The default state echo is tested end to end: SwarmClockTest.)
+// The component's own entry, DroneEstimator::Add and PopMessages, on purpose
+// (no driver): the test is of what PopMessages hands out and when.
 TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
   sim::Scenario scenario = IndoorScenario();
   ASSERT_FALSE(scenario.drones.empty());
@@ -90,7 +96,7 @@ TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
   ImuSample imu;
   imu.stamp_ns = t0;
   imu.linear_acceleration = Eigen::Vector3d(0, 0, 9.81);
-  ASSERT_TRUE(e->AddImu(imu).ok());
+  ASSERT_TRUE(e->Add(imu).ok());
 
   net::EgoStateMessage state;
   state.sender_id = 1;
@@ -98,7 +104,7 @@ TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
   net::ReceivedMessage received;
   received.arrival_ns = t0;
   received.message = state;
-  ASSERT_TRUE(e->AddMessage(received).ok());
+  ASSERT_TRUE(e->Add(received).ok());
   EXPECT_EQ(e->counters().messages_unsynchronized, 1);
 
   std::vector<net::SwarmMessage> out;
@@ -119,7 +125,7 @@ TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
   response.t3_ns = response.t2_ns + 100'000;
   received.arrival_ns = t0 + 2'100'000;
   received.message = response;
-  ASSERT_TRUE(e->AddMessage(received).ok());
+  ASSERT_TRUE(e->Add(received).ok());
   ASSERT_NE(e->clock_sync(), nullptr);
   const net::ClockOffsetEstimate estimate = e->clock_sync()->Estimate(1, t0);
   ASSERT_TRUE(estimate.valid);
@@ -129,7 +135,7 @@ TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
   state.stamp_ns = t0 + offset + 100'000'000;
   received.arrival_ns = t0 + 100'000'000;
   received.message = state;
-  ASSERT_TRUE(e->AddMessage(received).ok());
+  ASSERT_TRUE(e->Add(received).ok());
   EXPECT_EQ(e->counters().messages_unsynchronized, 1);
 
   // A request from the teammate is answered when the messages are taken:
@@ -140,9 +146,9 @@ TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
   theirs.t1_ns = t0 + offset + 200'000'000;
   received.arrival_ns = t0 + 201'000'000;
   received.message = theirs;
-  ASSERT_TRUE(e->AddMessage(received).ok());
+  ASSERT_TRUE(e->Add(received).ok());
   imu.stamp_ns = t0 + 205'000'000;
-  ASSERT_TRUE(e->AddImu(imu).ok());
+  ASSERT_TRUE(e->Add(imu).ok());
   out.clear();
   e->PopMessages(&out);
   const net::TimeSyncMessage* reply = nullptr;
@@ -167,7 +173,7 @@ TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) 
   sink.restart_at_s = 21.0;
   sink.indefinite_every_k = 7;  // bad covariances must be absorbed, not crash or poison P
   ASSERT_TRUE(run.Run());
-  DroneEstimator* estimator = run.estimator.get();
+  const DroneEstimator& estimator = run.estimator();
 
   ASSERT_GE(sink.outputs.size(), 180u);
   EXPECT_EQ(sink.ego_states_sent, static_cast<int>(sink.outputs.size()));
@@ -192,9 +198,9 @@ TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) 
   // Broadcast right after the identification, then every second until the reboot.
   EXPECT_GE(sink.extrinsic_messages_sent, (removed_at - identified_at) / 10);
   EXPECT_LE(sink.extrinsic_messages_sent, (removed_at - identified_at) / 10 + 2);
-  EXPECT_EQ(estimator->counters().teammate_restarts, 1);
+  EXPECT_EQ(estimator.counters().teammate_restarts, 1);
   // The component's own test: its odometry's state layout (no driver reads it).
-  EXPECT_TRUE(estimator->odometry().state().layout().teammate_ids().empty());
+  EXPECT_TRUE(estimator.odometry().state().layout().teammate_ids().empty());
   EXPECT_NEAR(ToSeconds(sink.outputs[static_cast<size_t>(removed_at)].ego.stamp_ns) -
                   ToSeconds(sink.outputs.front().ego.stamp_ns),
               21.0 - ToSeconds(sink.outputs.front().ego.stamp_ns - simulator.StampNs(observer, 0.0)),
@@ -272,7 +278,7 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
   // once per message, and only once the block exists (from 10 s on).
   int gravity = 0;
   for (const DroneOutput& o : sink.outputs) gravity += o.gravity_alignments;
-  EXPECT_EQ(gravity, run.estimator->counters().gravity_fused);
+  EXPECT_EQ(gravity, run.estimator().counters().gravity_fused);
   EXPECT_GT(gravity, 20);
   EXPECT_LE(gravity, sink.gravity_messages_delivered);
   const DroneOutput& last = sink.outputs.back();
@@ -280,12 +286,14 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
   const Eigen::Isometry3d T_true =
       ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
   EXPECT_LT((last.teammates[0].T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm(), 0.03);
-  EXPECT_EQ(run.estimator->counters().extrinsics_stale, 0);
+  EXPECT_EQ(run.estimator().counters().extrinsics_stale, 0);
 }
 
 // After a restart, teammates still broadcast their T_Gj_Gi of the previous
 // session for a moment: an entry naming this drone that was made before its
 // session began (by max_message_age_s) is not a mutual identification.
+// The component's own entry, DroneEstimator::Add, on purpose (no driver): the
+// counter after each message.
 TEST(DroneEstimator, IgnoresTeammatesExtrinsicsOfItsPreviousSession) {
   sim::Scenario scenario = IndoorScenario();
   const sim::DroneConfig& d = scenario.drones[0];
@@ -298,7 +306,7 @@ TEST(DroneEstimator, IgnoresTeammatesExtrinsicsOfItsPreviousSession) {
   imu.linear_acceleration = Eigen::Vector3d(0, 0, 9.81);
   for (int k = 0; k < 400 && !e->initialized(); ++k) {
     imu.stamp_ns = t0 + k * 5'000'000;
-    ASSERT_TRUE(e->AddImu(imu).ok());
+    ASSERT_TRUE(e->Add(imu).ok());
   }
   ASSERT_TRUE(e->initialized());
   const int64_t session_ns = e->initialization().stamp_ns;
@@ -312,12 +320,12 @@ TEST(DroneEstimator, IgnoresTeammatesExtrinsicsOfItsPreviousSession) {
   received.arrival_ns = session_ns + 100'000'000;
   g.stamp_ns = session_ns + 100'000'000;  // within max_message_age_s of the session start
   received.message = g;
-  ASSERT_TRUE(e->AddMessage(received).ok());
+  ASSERT_TRUE(e->Add(received).ok());
   EXPECT_EQ(e->counters().extrinsics_stale, 1);
   g.stamp_ns = session_ns + 600'000'000;  // after it: this session's
   received.arrival_ns = g.stamp_ns;
   received.message = g;
-  ASSERT_TRUE(e->AddMessage(received).ok());
+  ASSERT_TRUE(e->Add(received).ok());
   EXPECT_EQ(e->counters().extrinsics_stale, 1);
 }
 

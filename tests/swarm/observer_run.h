@@ -1,10 +1,11 @@
-// Test support for swarm::DroneEstimator driven directly (no bag, no
-// replay): one simulated drone of indoor_3uav feeds the component with its
-// IMU and LiDAR (ObserverRun), and a teammate's broadcasts are made from the
-// simulator's truth (ObserverSink: its state in its own G_j, stamps in the
-// observer's clock, 20 ms latency, every scan; each with the teammate's
-// observation of the observer, 2 cm noise). Shared by the tests in
-// tests/swarm/.
+// Test support for swarm::DroneEstimator without a bag or the replay: one
+// simulated drone of indoor_3uav feeds the component with its IMU and LiDAR
+// (ObserverRun), and a teammate's broadcasts are made from the simulator's
+// truth (ObserverSink: its state in its own G_j, stamps in the observer's
+// clock, 20 ms latency, every scan; each with the teammate's observation of
+// the observer, 2 cm noise). The records, the broadcasts among them, go
+// through driver::DroneDriver, the loop the replay and the live process run;
+// ObserverSink is its sink. Shared by the tests in tests/swarm/.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -22,6 +23,7 @@
 #include <variant>
 #include <vector>
 
+#include "swarmlio/driver/drone_driver.h"
 #include "swarmlio/driver/manifest.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
@@ -56,11 +58,25 @@ inline DroneEstimatorOptions OptionsFor(const sim::DroneConfig& d) {
   return o;
 }
 
-// Feeds the observer's sensor data and the teammate's broadcasts in time order.
-class ObserverSink : public sim::DroneSink {
+// The observer as a driver's drone: its sensors and the component's options
+// `o` (driver::EstimatorOptionsFor gives `o` back).
+inline driver::DroneInput InputFor(const sim::DroneConfig& d, const DroneEstimatorOptions& o) {
+  driver::DroneInput input;
+  input.name = d.name;
+  input.lidar = d.lidar.sensor;
+  input.imu = d.imu.sensor;
+  input.odometry = o.odometry;
+  input.teammate = o.teammate;
+  input.swarm = o.swarm;
+  return input;
+}
+
+// Feeds the observer's sensor data and the teammate's broadcasts in time order
+// to the observer's driver, and keeps what the driver hands to its sink.
+class ObserverSink : public sim::DroneSink, public driver::DriverSink {
  public:
-  ObserverSink(const sim::Simulator& sim, int observer, int teammate, DroneEstimator* estimator)
-      : sim_(sim), observer_(observer), teammate_(teammate), estimator_(estimator), rng_(5) {
+  ObserverSink(const sim::Simulator& sim, int observer, int teammate)
+      : sim_(sim), observer_(observer), teammate_(teammate), rng_(5) {
     const sim::DroneConfig& d = sim.drones()[static_cast<size_t>(teammate)];
     T_Gj_W_ = ToIsometry(sim.T_W_G(teammate)).inverse();
     const double period = 1.0 / d.lidar.sensor.scan_rate_hz;
@@ -68,29 +84,32 @@ class ObserverSink : public sim::DroneSink {
       broadcast_times_.push_back(d.lidar.start_time_s + k * period);
     }
   }
+  // The driver the records go to (created with this sink).
+  void set_driver(driver::DroneDriver* driver) { driver_ = driver; }
+
+  // sim::DroneSink: the data problems the component skips are the driver's
+  // warnings (ObserverRun::Run).
   Status OnImu(const ImuSample& imu) override {
     Deliver(imu.stamp_ns);
-    const Status status = estimator_->AddImu(imu);
-    Collect();
-    return status.code() == Status::Code::kInvalidArgument ? Status::Ok() : status;
+    driver_->Add(imu);
+    return Status::Ok();
   }
   Status OnScan(const LidarScan& scan, int64_t record_time_ns) override {
     Deliver(record_time_ns);
-    const Status status = estimator_->AddScan(scan);
-    Collect();
-    return status.code() == Status::Code::kInvalidArgument ? Status::Ok() : status;
+    driver_->Add(scan);
+    return Status::Ok();
   }
   Status OnGroundTruth(const PoseStamped& pose) override {
     ground_truth.push_back(pose);
     return Status::Ok();
   }
-  void Collect() {
-    std::vector<DroneOutput> out;
-    estimator_->PopOutputs(&out);
-    for (DroneOutput& o : out) outputs.push_back(std::move(o));
-    std::vector<net::SwarmMessage> sent;
-    estimator_->PopMessages(&sent);
-    for (const net::SwarmMessage& m : sent) {
+
+  // driver::DriverSink.
+  void OnOutputs(const std::vector<DroneOutput>& out) override {
+    outputs.insert(outputs.end(), out.begin(), out.end());
+  }
+  void OnMessages(std::vector<net::SwarmMessage>* sent) override {
+    for (const net::SwarmMessage& m : *sent) {
       if (const auto* e = std::get_if<net::EgoStateMessage>(&m)) {
         ++ego_states_sent;
         observations_sent += static_cast<int>(e->observations.size());
@@ -183,7 +202,7 @@ class ObserverSink : public sim::DroneSink {
       net::ReceivedMessage r;
       r.arrival_ns = sim_.StampNs(observer_, t + latency_s);
       r.message = m;
-      EXPECT_TRUE(estimator_->AddMessage(r).ok());
+      driver_->Add(r);
       if (relayed_id >= 0) {
         // The relayed drone broadcasts its state too (no observations).
         const sim::KinematicState sk =
@@ -199,7 +218,7 @@ class ObserverSink : public sim::DroneSink {
         mk.observations.clear();
         net::ReceivedMessage rk = r;
         rk.message = mk;
-        EXPECT_TRUE(estimator_->AddMessage(rk).ok());
+        driver_->Add(rk);
         net::GlobalExtrinsicMessage gk;
         gk.sender_id = relayed_id;
         gk.stamp_ns = m.stamp_ns;
@@ -223,7 +242,7 @@ class ObserverSink : public sim::DroneSink {
         }
         if (!gk.entries.empty()) {
           rk.message = gk;
-          EXPECT_TRUE(estimator_->AddMessage(rk).ok());
+          driver_->Add(rk);
         }
       }
       // The teammate's new session has not identified the observer.
@@ -252,7 +271,7 @@ class ObserverSink : public sim::DroneSink {
         g.g_in_Gi = T_Gj_W_.linear() * Eigen::Vector3d(0.0, 0.0, -kGravity);
         g.cov_g_in_Gi = 1e-4 * Eigen::Matrix3d::Identity();
         r.message = g;
-        EXPECT_TRUE(estimator_->AddMessage(r).ok());
+        driver_->Add(r);
         ++gravity_messages_delivered;
       }
     }
@@ -260,7 +279,7 @@ class ObserverSink : public sim::DroneSink {
 
   const sim::Simulator& sim_;
   int observer_, teammate_;
-  DroneEstimator* estimator_;
+  driver::DroneDriver* driver_ = nullptr;
   Eigen::Isometry3d T_Gj_W_;
   std::vector<double> broadcast_times_;
   size_t next_ = 0;
@@ -280,23 +299,30 @@ struct ObserverRun {
                                                  scenario.objects, config);
     DroneEstimatorOptions options = OptionsFor(drones[observer]);
     if (adjust) adjust(&options);
-    const Status created =
-        DroneEstimator::Create(observer, options, drones[observer].lidar.sensor, &estimator);
+    sink = std::make_unique<ObserverSink>(*simulator, observer, teammate);
+    const Status created = driver::DroneDriver::Create(InputFor(drones[observer], options),
+                                                       observer, sink.get(), &driver);
     EXPECT_TRUE(created.ok()) << created.message();
-    sink = std::make_unique<ObserverSink>(*simulator, observer, teammate, estimator.get());
+    sink->set_driver(driver.get());
   }
+  // The whole run; false when the simulator fails or the component skipped
+  // any input (a data problem, a failed update).
   bool Run() {
+    if (driver == nullptr) return false;
     sim::DroneStats stats;
     if (!simulator->RunDrone(observer, sink.get(), &stats).ok()) return false;
-    if (!estimator->Flush().ok()) return false;
-    sink->Collect();
-    return true;
+    driver->Finish();
+    driver->SendMessages();
+    EXPECT_EQ(driver->warnings().count, 0) << driver->warnings().first;
+    return driver->warnings().count == 0;
   }
+  const DroneEstimator& estimator() const { return driver->estimator(); }
+
   int observer;
   std::vector<sim::DroneConfig> drones;
   std::unique_ptr<sim::Simulator> simulator;
-  std::unique_ptr<DroneEstimator> estimator;
   std::unique_ptr<ObserverSink> sink;
+  std::unique_ptr<driver::DroneDriver> driver;  // feeds the component, writes to `sink`
 };
 
 }  // namespace swarmlio::swarm::test_support
