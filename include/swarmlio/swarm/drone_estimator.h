@@ -126,17 +126,12 @@ class DroneEstimator {
                        std::unique_ptr<DroneEstimator>* estimator);
   ~DroneEstimator();
 
-  /// One input: an IMU sample, a scan, or a received message. Processes
-  /// every scan the IMU now covers (PopOutputs). A data problem the
-  /// estimator skipped (a NaN sample, an out-of-order scan) is returned; the
-  /// estimator stays usable.
+  /// One input, the only entry: an IMU sample, a scan, or a received message
+  /// (arrival time in this drone's clock). Processes every scan the IMU now
+  /// covers (PopOutputs). A data problem the estimator skipped (a NaN sample,
+  /// an out-of-order scan) is returned; the estimator stays usable. Bad or
+  /// own messages are counted and ignored (Ok).
   Status Add(const SensorRecord& record);
-  /// The three kinds of Add.
-  Status AddImu(const ImuSample& sample);
-  Status AddScan(const LidarScan& scan);
-  /// A message from the network (arrival time in this drone's clock). Bad
-  /// or own messages are counted and ignored (Ok).
-  Status AddMessage(const net::ReceivedMessage& message);
   /// End of the log: processes the waiting scans.
   Status Flush();
   /// Ablation: fuse active and passive observations (per the options) or
@@ -173,6 +168,11 @@ class DroneEstimator {
  private:
   struct Parts;
   DroneEstimator(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar);
+
+  // The three kinds of Add.
+  Status AddImu(const ImuSample& sample);
+  Status AddScan(const LidarScan& scan);
+  Status AddMessage(const net::ReceivedMessage& message);
 
   // Every scan the odometry hands out, through the pass; the first error.
   Status ProcessReadyScans(bool flush);
