@@ -1,6 +1,6 @@
 // DroneDriver: the one loop every driver runs around a drone's component
 // (the offline replay's DroneRunner, the live process's LiveDrone and, through
-// it, the ROS node):
+// it, the ROS node; the tests' ObserverRun):
 //
 //   read record -> Add(record) -> component.Add(record)
 //                              -> its outputs, then its messages -> the sink
