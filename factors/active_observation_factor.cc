@@ -4,14 +4,6 @@
 #include "swarmlio/math/so3.h"
 
 namespace swarmlio {
-namespace {
-
-Eigen::Matrix3d RotationOf(const Eigen::Quaterniond& q) {
-  return q.normalized().toRotationMatrix();
-}
-
-}  // namespace
-
 ActiveObservationFactor::ActiveObservationFactor(const Eigen::Vector3d& p_bj_in_bi,
                                                  const Eigen::Vector3d& p_bj_in_Gj,
                                                  const Eigen::Matrix3d& Sigma_obs,
@@ -27,9 +19,9 @@ ActiveObservationFactor::ActiveObservationFactor(const Eigen::Vector3d& p_bj_in_
 
 Eigen::Vector3d ActiveObservationFactor::Predict(const EgoState& ego,
                                                  const GlobalExtrinsic& extrinsic) const {
-  const Eigen::Matrix3d R_Gi_bi = RotationOf(ego.q_G_b);
+  const Eigen::Matrix3d R_Gi_bi = so3::RotationOf(ego.q_G_b);
   const Eigen::Vector3d p_bj_in_Gi =
-      RotationOf(extrinsic.q_Gi_Gj) * p_bj_in_Gj_ + extrinsic.p_Gj_in_Gi;
+      so3::RotationOf(extrinsic.q_Gi_Gj) * p_bj_in_Gj_ + extrinsic.p_Gj_in_Gi;
   return R_Gi_bi.transpose() * (p_bj_in_Gi - ego.p_b_in_G);
 }
 
@@ -43,7 +35,7 @@ void ActiveObservationFactor::TangentJacobian(
     const GlobalExtrinsic& extrinsic,
     Eigen::Matrix<double, 3, EgoState::kTangentSize>* J_ego,
     Eigen::Matrix<double, 3, GlobalExtrinsic::kTangentSize>* J_ext) const {
-  const Eigen::Matrix3d Rt_Gi_bi = RotationOf(ego.q_G_b).transpose();
+  const Eigen::Matrix3d Rt_Gi_bi = so3::RotationOf(ego.q_G_b).transpose();
   if (J_ego != nullptr) {
     J_ego->setZero();
     J_ego->block<3, 3>(0, ErrorStateLayout::kRotation.offset) =
@@ -53,7 +45,7 @@ void ActiveObservationFactor::TangentJacobian(
   if (J_ext != nullptr) {
     const Eigen::Matrix3d W_Rt = sqrt_information_ * Rt_Gi_bi;
     J_ext->block<3, 3>(0, ErrorStateLayout::kTeammateRotationOffset) =
-        -W_Rt * RotationOf(extrinsic.q_Gi_Gj) * so3::Hat(p_bj_in_Gj_);
+        -W_Rt * so3::RotationOf(extrinsic.q_Gi_Gj) * so3::Hat(p_bj_in_Gj_);
     J_ext->block<3, 3>(0, ErrorStateLayout::kTeammateTranslationOffset) = W_Rt;
   }
 }

@@ -13,10 +13,6 @@ namespace {
 using L = ErrorStateLayout;
 using Matrix18 = PreintegratedImu::Matrix18;
 
-Eigen::Matrix3d RotationOf(const Eigen::Quaterniond& q) {
-  return q.normalized().toRotationMatrix();
-}
-
 // 3x3 block (rows of segment r, columns of segment c).
 auto Block(Matrix18& m, const Segment& r, const Segment& c) {
   return m.block<3, 3>(r.offset, c.offset);
@@ -88,8 +84,8 @@ ImuPreintegrationFactor::ResidualVector ImuPreintegrationFactor::Compute(
     TangentJacobianMatrix* E_k1) const {
   const PreintegratedImu& m = preintegrated_;
   const double T = m.dt_s;
-  const Eigen::Matrix3d R_k = RotationOf(ego_k.q_G_b);
-  const Eigen::Matrix3d R_k1 = RotationOf(ego_k1.q_G_b);
+  const Eigen::Matrix3d R_k = so3::RotationOf(ego_k.q_G_b);
+  const Eigen::Matrix3d R_k1 = so3::RotationOf(ego_k1.q_G_b);
   const Eigen::Matrix3d Rt_k = R_k.transpose();
   const Eigen::Vector3d dbg = ego_k.gyro_bias - m.gyro_bias_lin;
   const Eigen::Vector3d c = m.dR_dbg * dbg;

@@ -6,13 +6,6 @@
 
 namespace swarmlio::eval {
 
-namespace {
-
-// Rotation blocks read from 6-digit KITTI files are orthonormal to ~1e-6.
-constexpr double kMaxOrthonormalityError = 1e-4;
-
-}  // namespace
-
 Eigen::Matrix3Xd Trajectory::Positions() const {
   Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(T_G_b.size()));
   for (size_t i = 0; i < T_G_b.size(); ++i) {

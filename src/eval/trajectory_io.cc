@@ -21,8 +21,6 @@ constexpr size_t kEurocValues = 8;
 constexpr double kNsPerS = 1e9;
 // A quaternion this close to zero has no defined rotation.
 constexpr double kMinQuaternionNorm = 1e-9;
-// Same tolerance as ValidateTrajectory (6-digit KITTI files).
-constexpr double kMaxOrthonormalityError = 1e-4;
 
 std::string Where(const std::string& path, int line_number) {
   return path + ":" + std::to_string(line_number) + ": ";

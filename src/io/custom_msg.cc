@@ -25,7 +25,7 @@ constexpr char kCustomPointText[] =
     "uint8 tag               # Livox tag\n"
     "uint8 line              # laser line\n";
 
-std::string BuildFullDefinition() {
+std::string BuildLivoxCustomMsgDefinition() {
   // genmsg's full text: the message text, then for every dependency (in field
   // order) a separator line, "MSG: <type>" and the dependency's text, with
   // one blank line between the parts and no newline added at the very end.
@@ -41,7 +41,7 @@ std::string BuildFullDefinition() {
 }  // namespace
 
 const std::string& LivoxCustomMsgDefinition() {
-  static const std::string* const kDefinition = new std::string(BuildFullDefinition());
+  static const std::string* const kDefinition = new std::string(BuildLivoxCustomMsgDefinition());
   return *kDefinition;
 }
 

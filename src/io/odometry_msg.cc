@@ -41,7 +41,7 @@ void AppendSection(std::string* text) {
   *text += OwnText<M>();
 }
 
-std::string BuildFullDefinition() {
+std::string BuildNavOdometryDefinition() {
   std::string text = kOdometryText;
   AppendSection<std_msgs::Header>(&text);
   AppendSection<geometry_msgs::PoseWithCovariance>(&text);
@@ -57,7 +57,7 @@ std::string BuildFullDefinition() {
 }  // namespace
 
 const std::string& NavOdometryDefinition() {
-  static const std::string* const kDefinition = new std::string(BuildFullDefinition());
+  static const std::string* const kDefinition = new std::string(BuildNavOdometryDefinition());
   return *kDefinition;
 }
 

@@ -9,7 +9,6 @@ namespace swarmlio::net::internal {
 
 namespace {
 // The bits byte: quaternion largest index, degenerated, observation count.
-constexpr uint8_t kLargestMask = 0x03;
 constexpr uint8_t kDegeneratedFlag = 0x04;
 constexpr int kCountShift = 3;
 
@@ -111,7 +110,7 @@ Status DecodeEgoState(int sender_id, PacketReader* r, EgoStateMessage* out) {
                             " payload bytes but the payload has " +
                             std::to_string(r->position() + r->remaining()));
   }
-  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Gj_bj", bits & kLargestMask, r, &m.q_Gj_bj));
+  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Gj_bj", bits & kQuaternionLargestMask, r, &m.q_Gj_bj));
   SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("p_bj_in_Gj", r, &m.p_bj_in_Gj));
   SWARMLIO_RETURN_IF_ERROR(ReadVectorF16("v_bj_in_Gj", r, &m.v_bj_in_Gj));
   SWARMLIO_RETURN_IF_ERROR(ReadVectorF16("omega_bj_in_bj", r, &m.omega_bj_in_bj));

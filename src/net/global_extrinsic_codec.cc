@@ -9,9 +9,8 @@ namespace swarmlio::net::internal {
 namespace {
 
 // The entry's bits byte: quaternion largest index, source.
-constexpr uint8_t kLargestMask = 0x03;
 constexpr uint8_t kGraphSourceFlag = 0x04;
-constexpr uint8_t kKnownBits = kLargestMask | kGraphSourceFlag;
+constexpr uint8_t kKnownBits = kQuaternionLargestMask | kGraphSourceFlag;
 
 Status DecodeEntry(PacketReader* r, GlobalExtrinsicEntry* e) {
   uint8_t id = 0;
@@ -24,7 +23,7 @@ Status DecodeEntry(PacketReader* r, GlobalExtrinsicEntry* e) {
   e->teammate_id = id;
   e->source =
       (bits & kGraphSourceFlag) != 0 ? ExtrinsicSource::kGraph : ExtrinsicSource::kTrajectoryMatch;
-  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Gi_Gj", bits & kLargestMask, r, &e->q_Gi_Gj));
+  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Gi_Gj", bits & kQuaternionLargestMask, r, &e->q_Gi_Gj));
   SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("p_Gj_in_Gi", r, &e->p_Gj_in_Gi));
   return ReadCovariance<6>("covariance", r, &e->covariance);
 }

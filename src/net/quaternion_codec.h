@@ -19,6 +19,9 @@
 
 namespace swarmlio::net::internal {
 
+/// The low two bits of a payload's bits byte: QuaternionCodes::largest.
+constexpr uint8_t kQuaternionLargestMask = 0x03;
+
 struct QuaternionCodes {
   uint8_t largest = 3;  // index (x y z w = 0 1 2 3) of the dropped coefficient
   std::array<int16_t, 3> sent = {0, 0, 0};

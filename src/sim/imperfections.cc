@@ -5,12 +5,12 @@
 #include <cmath>
 #include <random>
 
+#include "swarmlio/math/angles.h"
 #include "swarmlio/math/so3.h"
 
 namespace swarmlio::sim {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 // "" when `range` is [min, max] with min <= max, else "key: reason".
 std::string CheckInterval(const char* key, const std::vector<double>& range) {
@@ -74,7 +74,7 @@ ImuImperfectionOptions RealisticImuImperfections() {
   o.accel_scale_factor_sigma = 0.005;
   o.gyro_misalignment_sigma_rad = 0.005;  // cross-axis sensitivity +-1 % as 2 sigma
   o.accel_misalignment_sigma_rad = 0.005;
-  o.gyro_lsb_rad_s = 2000.0 / 32768.0 * kDeg;   // +-2000 deg/s over 16 bit
+  o.gyro_lsb_rad_s = 2000.0 / 32768.0 * kRadiansPerDegree;   // +-2000 deg/s over 16 bit
   o.accel_lsb_m_s2 = 24.0 * 9.80665 / 32768.0;  // BMI088 +-24 g over 16 bit
   o.sample_dropout_probability = 1e-3;
   o.timestamp_jitter_s = 1e-4;
@@ -124,7 +124,7 @@ CalibrationError DrawCalibrationError(const CalibrationErrorOptions& options, ui
     return d.normalized();
   };
   CalibrationError e;
-  const double angle = magnitude(options.extrinsic_rotation_deg) * kDeg;
+  const double angle = magnitude(options.extrinsic_rotation_deg) * kRadiansPerDegree;
   e.rotation_rad = angle * direction();
   const double length = magnitude(options.extrinsic_translation_m);
   e.translation_m = length * direction();

@@ -4,13 +4,13 @@
 #include <cmath>
 
 #include "swarmlio/common/check.h"
+#include "swarmlio/math/angles.h"
 #include "swarmlio/sim/random.h"
 #include "swarmlio/sim/reflectivity.h"
 
 namespace swarmlio::sim {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 // Sub-streams of a LidarModel's seed for the imperfections (the base stream is
 // the seed itself, as it always was).
 constexpr uint64_t kImperfectionStream = 1;
@@ -34,7 +34,7 @@ void NormalPair(uint64_t key, uint64_t pulse, uint64_t first, double* a, double*
   *b = radius * std::sin(angle);
 }
 // The incidence term of the range noise stops growing at 85 deg.
-const double kMinCosIncidence = std::cos(85.0 * kDeg);
+const double kMinCosIncidence = std::cos(85.0 * kRadiansPerDegree);
 constexpr uint8_t kFirstReturn = 0x10;   // Livox tag bits 5:4 = 01
 constexpr uint8_t kSecondReturn = 0x20;  // Livox tag bits 5:4 = 10
 
@@ -138,9 +138,9 @@ void LidarModel::CollectCandidates(double start_time_s) {
 LidarModel::Footprint LidarModel::BeamFootprint() const {
   const LidarImperfectionOptions& imp = options_.imperfections;
   Footprint f;
-  f.angular_sigma = imp.angular_noise_deg * kDeg;
-  f.half_divergence_h = 0.5 * imp.beam_divergence_horizontal_deg * kDeg;
-  f.half_divergence_v = 0.5 * imp.beam_divergence_vertical_deg * kDeg;
+  f.angular_sigma = imp.angular_noise_deg * kRadiansPerDegree;
+  f.half_divergence_h = 0.5 * imp.beam_divergence_horizontal_deg * kRadiansPerDegree;
+  f.half_divergence_v = 0.5 * imp.beam_divergence_vertical_deg * kRadiansPerDegree;
   f.divergence_rms = std::sqrt(2.0 * (f.half_divergence_h * f.half_divergence_h +
                                       f.half_divergence_v * f.half_divergence_v));
   f.needs_axes = f.angular_sigma > 0.0 || imp.SamplesFootprint();

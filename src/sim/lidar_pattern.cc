@@ -4,18 +4,18 @@
 #include <cmath>
 
 #include "swarmlio/common/check.h"
+#include "swarmlio/math/angles.h"
 
 namespace swarmlio::sim {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kTwoPi = 2.0 * M_PI;
 
 // Avia: prism rates [rev/s] (incommensurate, counter-rotating) and the small
 // angular offsets of the emitters (a slanted column).
 constexpr double kAviaPrism1RevPerS = 97.31;
 constexpr double kAviaPrism2RevPerS = -71.93;
-constexpr double kAviaEmitterSpacing = 0.45 * kDeg;
+constexpr double kAviaEmitterSpacing = 0.45 * kRadiansPerDegree;
 
 // Mid-360: line sweep frequency [Hz] (incommensurate with the scan rate so the
 // pattern precesses).
@@ -40,9 +40,9 @@ LidarPattern::LidarPattern(const LidarOptions& sensor) : sensor_(sensor) {
 void LidarPattern::Direction(int64_t k, Eigen::Vector3d* direction_l, uint8_t* line) const {
   const double t = static_cast<double>(k) / pulse_rate_hz_;
   const int l = static_cast<int>(k % lines_);
-  const double fov_h = sensor_.fov_horizontal_deg * kDeg;
-  const double el_min = sensor_.fov_vertical_min_deg * kDeg;
-  const double el_max = sensor_.fov_vertical_max_deg * kDeg;
+  const double fov_h = sensor_.fov_horizontal_deg * kRadiansPerDegree;
+  const double el_min = sensor_.fov_vertical_min_deg * kRadiansPerDegree;
+  const double el_max = sensor_.fov_vertical_max_deg * kRadiansPerDegree;
   *line = static_cast<uint8_t>(l);
   switch (sensor_.type) {
     case LidarType::kLivoxAvia: {

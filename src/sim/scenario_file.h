@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "swarmlio/common/option_fields.h"
+#include "swarmlio/math/angles.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/trajectory_builder.h"
 
@@ -65,7 +66,6 @@ namespace swarmlio::sim::scenario_file {
 
 using config::FieldSpec;
 
-constexpr double kDeg = M_PI / 180.0;
 
 struct ArenaSpec {
   Eigen::Vector3d size_m = Eigen::Vector3d::Zero();  // inner size; 0 = no arena
@@ -137,9 +137,9 @@ struct PrimitiveSpec {
   }
   Primitive Make() const {
     const Material mat{material, reflectivity_percent};
-    const Eigen::Matrix3d R = (Eigen::AngleAxisd(rpy_deg.z() * kDeg, Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(rpy_deg.y() * kDeg, Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(rpy_deg.x() * kDeg, Eigen::Vector3d::UnitX()))
+    const Eigen::Matrix3d R = (Eigen::AngleAxisd(rpy_deg.z() * kRadiansPerDegree, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(rpy_deg.y() * kRadiansPerDegree, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(rpy_deg.x() * kRadiansPerDegree, Eigen::Vector3d::UnitX()))
                                   .toRotationMatrix();
     switch (type) {
       case PrimitiveKind::kBox:
@@ -194,10 +194,10 @@ struct PlanStepSpec {
         b->Takeoff(height_m);
         break;
       case PlanKind::kTransit:
-        b->TransitTo(target_m, yaw_deg * kDeg);
+        b->TransitTo(target_m, yaw_deg * kRadiansPerDegree);
         break;
       case PlanKind::kExcite:
-        b->Excite(duration_s, amplitude_m, yaw_amplitude_deg * kDeg, period_s);
+        b->Excite(duration_s, amplitude_m, yaw_amplitude_deg * kRadiansPerDegree, period_s);
         break;
     }
   }
@@ -222,7 +222,7 @@ struct MotionSpec {
     v("plan", plan, FieldSpec::Doc("flight plan, run in order after the start"));
   }
   Trajectory Build(uint64_t seed, double duration_s) const {
-    TrajectoryBuilder b(start_m, start_yaw_deg * kDeg, trajectory, seed);
+    TrajectoryBuilder b(start_m, start_yaw_deg * kRadiansPerDegree, trajectory, seed);
     for (const PlanStepSpec& step : plan) step.AppendTo(&b);
     return b.Build(0.0, duration_s + 1.0, attitude);
   }

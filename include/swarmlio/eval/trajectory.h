@@ -45,6 +45,11 @@ struct Trajectory {
   bool PoseAt(double stamp_s, double max_gap_s, Eigen::Isometry3d* T_G_b) const;
 };
 
+/// Largest max |R^T R - I| of a pose's rotation part that is accepted as a
+/// rotation (rotation blocks read from 6-digit KITTI files are orthonormal to
+/// ~1e-6).
+inline constexpr double kMaxOrthonormalityError = 1e-4;
+
 /// A stamped trajectory from poses of b in G (e.g. estimator output or bag
 /// ground truth): stamps ToSeconds(stamp_ns), rotations from the
 /// normalised quaternions. No checks (see ValidateTrajectory).

@@ -52,4 +52,10 @@ Eigen::Matrix3d LeftJacobianInverse(const Eigen::Vector3d& w);
 /// Projects a nearly orthonormal matrix onto SO(3) (via the quaternion).
 Eigen::Matrix3d Normalize(const Eigen::Matrix3d& R);
 
+/// The rotation of q after normalizing it (a state's quaternion may drift
+/// off the unit sphere by round-off between updates).
+inline Eigen::Matrix3d RotationOf(const Eigen::Quaterniond& q) {
+  return q.normalized().toRotationMatrix();
+}
+
 }  // namespace swarmlio::so3
