@@ -67,8 +67,8 @@ void MessageInbox::OnExtrinsics(const net::GlobalExtrinsicMessage& g, const OwnS
     return;
   }
   for (const net::GlobalExtrinsicEntry& e : g.entries) {
-    if (!e.q_Gi_Gj.coeffs().allFinite() || !e.p_Gj_in_Gi.allFinite() ||
-        !e.covariance.allFinite() || e.teammate_id < 0) {
+    if (!e.q_Ga_Gb.coeffs().allFinite() || !e.p_Gb_in_Ga.allFinite() || !e.covariance.allFinite() ||
+        e.teammate_id < 0) {
       continue;
     }
     if (e.teammate_id == self_id_) {

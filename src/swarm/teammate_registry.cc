@@ -70,8 +70,8 @@ void TeammateRegistry::AddMatched(int64_t t_k, const teammate::ScanResult& detec
   for (const teammate::TeammateIdentification& id : detection.identifications) {
     if (x->HasTeammate(id.drone_id)) continue;
     GlobalExtrinsic T;
-    T.q_Gi_Gj = Eigen::Quaterniond(id.R_Gi_Gj).normalized();
-    T.p_Gj_in_Gi = id.p_Gj_in_Gi;
+    T.q_Ga_Gb = Eigen::Quaterniond(id.R_Gi_Gj).normalized();
+    T.p_Gb_in_Ga = id.p_Gj_in_Gi;
     const double sigma_p = std::max(so.init_translation_sigma_floor_m,
                                     so.init_translation_sigma_per_residual * id.mean_residual_m);
     // The excitation flights span about a metre: a translation error sigma_p
@@ -95,7 +95,7 @@ void TeammateRegistry::AddMutual(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P,
     GlobalExtrinsic T;
     Eigen::Matrix<double, 6, 6> C;
     InvertExtrinsic(pending.entry, &T, &C);
-    if (!detector_->AddIdentifiedTeammate(j, t_k, T.R_Gi_Gj(), T.p_Gj_in_Gi)) continue;
+    if (!detector_->AddIdentifiedTeammate(j, t_k, T.R_Ga_Gb(), T.p_Gb_in_Ga)) continue;
     // Positive definite whatever arrived, and at least the covariance of an
     // own match with zero residual.
     C = Regularized<6>(C, 1e-10);
@@ -132,8 +132,8 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
       const auto it_k = teammates_.find(k);
       if (it_k != teammates_.end() && it_k->second.restarted) continue;
       GlobalExtrinsic T_jk;
-      T_jk.q_Gi_Gj = e.q_Gi_Gj.normalized();
-      T_jk.p_Gj_in_Gi = e.p_Gj_in_Gi;
+      T_jk.q_Ga_Gb = e.q_Ga_Gb.normalized();
+      T_jk.p_Gb_in_Ga = e.p_Gb_in_Ga;
       Candidate c;
       Eigen::Matrix<double, 6, 6> J_jk;
       ComposeExtrinsic(x->teammate(j), T_jk, &c.T, &c.J_ij, &J_jk);
@@ -145,7 +145,7 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
     }
   }
   for (const auto& [k, c] : best) {
-    if (!detector_->AddIdentifiedTeammate(k, t_k, c.T.R_Gi_Gj(), c.T.p_Gj_in_Gi)) continue;
+    if (!detector_->AddIdentifiedTeammate(k, t_k, c.T.R_Ga_Gb(), c.T.p_Gb_in_Ga)) continue;
     // Cross-covariances: d(T_ik) = J_ij d(T_ij) + J_jk d(T_jk) with d(T_jk)
     // independent of this drone's state, so P(k, :) = J_ij P(j, :).
     const int n = static_cast<int>(P->rows());
@@ -200,10 +200,10 @@ std::vector<TeammateEstimate> TeammateRegistry::Estimates(int64_t t_k, const Swa
     if (info.have_message &&
         std::abs(ToSeconds(t_k - info.last.stamp_ns)) <= options_.max_message_age_s) {
       const PredictedTeammate j = Predict(info.last, ToSeconds(t_k - info.last.stamp_ns));
-      const Eigen::Matrix3d R_Gi_Gj = e.T_Gi_Gj.R_Gi_Gj();
+      const Eigen::Matrix3d R_Gi_Gj = e.T_Gi_Gj.R_Ga_Gb();
       e.have_pose = true;
       e.q_Gi_bj = Eigen::Quaterniond(R_Gi_Gj * j.R_Gj_bj).normalized();
-      e.p_bj_in_Gi = R_Gi_Gj * j.p_bj_in_Gj + e.T_Gi_Gj.p_Gj_in_Gi;
+      e.p_bj_in_Gi = R_Gi_Gj * j.p_bj_in_Gj + e.T_Gi_Gj.p_Gb_in_Ga;
       e.v_bj_in_Gi = R_Gi_Gj * j.v_bj_in_Gj;
     }
     e.seen = info.last_seen_ns == t_k;
