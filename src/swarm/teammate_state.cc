@@ -80,16 +80,18 @@ void ComposeExtrinsic(const GlobalExtrinsic& T_ij, const GlobalExtrinsic& T_jk, 
   J_jk->bottomRightCorner<3, 3>() = R_ij;
 }
 
-void InvertExtrinsic(const net::GlobalExtrinsicEntry& e, GlobalExtrinsic* T,
-                     Eigen::Matrix<double, 6, 6>* C) {
-  const Eigen::Matrix3d R = e.q_Ga_Gb.normalized().toRotationMatrix();
-  T->q_Ga_Gb = e.q_Ga_Gb.normalized().conjugate();
-  T->p_Gb_in_Ga = -(R.transpose() * e.p_Gb_in_Ga);
+void InvertExtrinsic(const GlobalExtrinsic& T_Gj_Gi,
+                     const Eigen::Matrix<double, 6, 6>& cov_T_Gj_Gi,
+                     GlobalExtrinsic* T_Gi_Gj,
+                     Eigen::Matrix<double, 6, 6>* cov_T_Gi_Gj) {
+  const Eigen::Matrix3d R = T_Gj_Gi.R_Ga_Gb();  // R_Gj_Gi
+  T_Gi_Gj->q_Ga_Gb = T_Gj_Gi.q_Ga_Gb.conjugate();
+  T_Gi_Gj->p_Gb_in_Ga = -(R.transpose() * T_Gj_Gi.p_Gb_in_Ga);
   Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
   J.topLeftCorner<3, 3>() = -R;
-  J.bottomLeftCorner<3, 3>() = so3::Hat(T->p_Gb_in_Ga);
+  J.bottomLeftCorner<3, 3>() = so3::Hat(T_Gi_Gj->p_Gb_in_Ga);
   J.bottomRightCorner<3, 3>() = -R.transpose();
-  *C = J * e.covariance * J.transpose();
+  *cov_T_Gi_Gj = J * cov_T_Gj_Gi * J.transpose();
 }
 
 }  // namespace swarmlio::swarm::internal
