@@ -21,7 +21,7 @@ Eigen::Vector3d ActiveObservationFactor::Predict(const EgoState& ego,
                                                  const GlobalExtrinsic& extrinsic) const {
   const Eigen::Matrix3d R_Gi_bi = so3::RotationOf(ego.q_G_b);
   const Eigen::Vector3d p_bj_in_Gi =
-      so3::RotationOf(extrinsic.q_Gi_Gj) * p_bj_in_Gj_ + extrinsic.p_Gj_in_Gi;
+      so3::RotationOf(extrinsic.q_Ga_Gb) * p_bj_in_Gj_ + extrinsic.p_Gb_in_Ga;
   return R_Gi_bi.transpose() * (p_bj_in_Gi - ego.p_b_in_G);
 }
 
@@ -45,7 +45,7 @@ void ActiveObservationFactor::TangentJacobian(
   if (J_ext != nullptr) {
     const Eigen::Matrix3d W_Rt = sqrt_information_ * Rt_Gi_bi;
     J_ext->block<3, 3>(0, ErrorStateLayout::kTeammateRotationOffset) =
-        -W_Rt * so3::RotationOf(extrinsic.q_Gi_Gj) * so3::Hat(p_bj_in_Gj_);
+        -W_Rt * so3::RotationOf(extrinsic.q_Ga_Gb) * so3::Hat(p_bj_in_Gj_);
     J_ext->block<3, 3>(0, ErrorStateLayout::kTeammateTranslationOffset) = W_Rt;
   }
 }

@@ -18,7 +18,7 @@ GravityAlignmentFactor::GravityAlignmentFactor(const Eigen::Vector3d& g_in_Gj,
 
 Eigen::Vector3d GravityAlignmentFactor::Predict(const EgoState& ego,
                                                 const GlobalExtrinsic& extrinsic) const {
-  return extrinsic.q_Gi_Gj.normalized().toRotationMatrix() * g_in_Gj_ - ego.g_in_G;
+  return extrinsic.q_Ga_Gb.normalized().toRotationMatrix() * g_in_Gj_ - ego.g_in_G;
 }
 
 Eigen::Vector3d GravityAlignmentFactor::Residual(const EgoState& ego,
@@ -37,7 +37,7 @@ void GravityAlignmentFactor::TangentJacobian(
   if (J_ext != nullptr) {
     J_ext->setZero();
     J_ext->block<3, 3>(0, ErrorStateLayout::kTeammateRotationOffset) =
-        -sqrt_information_ * extrinsic.q_Gi_Gj.normalized().toRotationMatrix() * so3::Hat(g_in_Gj_);
+        -sqrt_information_ * extrinsic.q_Ga_Gb.normalized().toRotationMatrix() * so3::Hat(g_in_Gj_);
   }
 }
 

@@ -37,8 +37,8 @@ Eigen::Vector3d PassiveObservationFactor::C(const EgoState& ego) const {
 Eigen::Vector3d PassiveObservationFactor::EgoPositionInGj(const EgoState& ego,
                                                           const GlobalExtrinsic& extrinsic) const {
   const Eigen::Vector3d A = ego.R_G_b() * C(ego) + W_ * ego.g_in_G;
-  return so3::RotationOf(extrinsic.q_Gi_Gj).transpose() *
-         (ego.p_b_in_G + ego.v_b_in_G * dt_ + A - extrinsic.p_Gj_in_Gi);
+  return so3::RotationOf(extrinsic.q_Ga_Gb).transpose() *
+         (ego.p_b_in_G + ego.v_b_in_G * dt_ + A - extrinsic.p_Gb_in_Ga);
 }
 
 Eigen::Vector3d PassiveObservationFactor::Predict(const EgoState& ego,
@@ -57,7 +57,7 @@ void PassiveObservationFactor::TangentJacobian(
     Eigen::Matrix<double, 3, EgoState::kTangentSize>* J_ego,
     Eigen::Matrix<double, 3, GlobalExtrinsic::kTangentSize>* J_ext) const {
   const Eigen::Matrix3d W_M =
-      sqrt_information_ * R_Gj_bj_.transpose() * so3::RotationOf(extrinsic.q_Gi_Gj).transpose();
+      sqrt_information_ * R_Gj_bj_.transpose() * so3::RotationOf(extrinsic.q_Ga_Gb).transpose();
   if (J_ego != nullptr) {
     J_ego->setZero();
     J_ego->block<3, 3>(0, ErrorStateLayout::kPosition.offset) = W_M;

@@ -80,38 +80,38 @@ Eigen::Matrix<double, EgoState::kTangentSize, 1> EgoState::BoxMinus(const EgoSta
   return d;
 }
 
-Eigen::Isometry3d GlobalExtrinsic::T_Gi_Gj() const {
+Eigen::Isometry3d GlobalExtrinsic::T_Ga_Gb() const {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = R_Gi_Gj();
-  T.translation() = p_Gj_in_Gi;
+  T.linear() = R_Ga_Gb();
+  T.translation() = p_Gb_in_Ga;
   return T;
 }
 
 void GlobalExtrinsic::ToParameters(double* x) const {
-  WriteQuaternion(q_Gi_Gj, x);
-  Eigen::Map<Eigen::Vector3d>(x + 4) = p_Gj_in_Gi;
+  WriteQuaternion(q_Ga_Gb, x);
+  Eigen::Map<Eigen::Vector3d>(x + 4) = p_Gb_in_Ga;
 }
 
 GlobalExtrinsic GlobalExtrinsic::FromParameters(const double* x) {
   GlobalExtrinsic e;
-  e.q_Gi_Gj = ReadQuaternion(x);
-  e.p_Gj_in_Gi = Eigen::Map<const Eigen::Vector3d>(x + 4);
+  e.q_Ga_Gb = ReadQuaternion(x);
+  e.p_Gb_in_Ga = Eigen::Map<const Eigen::Vector3d>(x + 4);
   return e;
 }
 
 GlobalExtrinsic GlobalExtrinsic::BoxPlus(
     const Eigen::Matrix<double, kTangentSize, 1>& dx) const {
   GlobalExtrinsic e;
-  e.q_Gi_Gj = RotationPlus(q_Gi_Gj, dx.segment<3>(L::kTeammateRotationOffset));
-  e.p_Gj_in_Gi = p_Gj_in_Gi + dx.segment<3>(L::kTeammateTranslationOffset);
+  e.q_Ga_Gb = RotationPlus(q_Ga_Gb, dx.segment<3>(L::kTeammateRotationOffset));
+  e.p_Gb_in_Ga = p_Gb_in_Ga + dx.segment<3>(L::kTeammateTranslationOffset);
   return e;
 }
 
 Eigen::Matrix<double, GlobalExtrinsic::kTangentSize, 1> GlobalExtrinsic::BoxMinus(
     const GlobalExtrinsic& other) const {
   Eigen::Matrix<double, kTangentSize, 1> d;
-  d.segment<3>(L::kTeammateRotationOffset) = RotationMinus(q_Gi_Gj, other.q_Gi_Gj);
-  d.segment<3>(L::kTeammateTranslationOffset) = p_Gj_in_Gi - other.p_Gj_in_Gi;
+  d.segment<3>(L::kTeammateRotationOffset) = RotationMinus(q_Ga_Gb, other.q_Ga_Gb);
+  d.segment<3>(L::kTeammateTranslationOffset) = p_Gb_in_Ga - other.p_Gb_in_Ga;
   return d;
 }
 

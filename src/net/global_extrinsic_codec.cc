@@ -23,8 +23,8 @@ Status DecodeEntry(PacketReader* r, GlobalExtrinsicEntry* e) {
   e->teammate_id = id;
   e->source =
       (bits & kGraphSourceFlag) != 0 ? ExtrinsicSource::kGraph : ExtrinsicSource::kTrajectoryMatch;
-  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Gi_Gj", bits & kQuaternionLargestMask, r, &e->q_Gi_Gj));
-  SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("p_Gj_in_Gi", r, &e->p_Gj_in_Gi));
+  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Ga_Gb", bits & kQuaternionLargestMask, r, &e->q_Ga_Gb));
+  SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("p_Gb_in_Ga", r, &e->p_Gb_in_Ga));
   return ReadCovariance<6>("covariance", r, &e->covariance);
 }
 
@@ -36,12 +36,12 @@ void EncodeGlobalExtrinsic(const GlobalExtrinsicMessage& m, PacketWriter* w) {
   WriteCovariance<3>(m.cov_g_in_Gi, w);
   w->U8(static_cast<uint8_t>(m.entries.size()));
   for (const GlobalExtrinsicEntry& e : m.entries) {
-    const QuaternionCodes q = EncodeQuaternion(e.q_Gi_Gj);
+    const QuaternionCodes q = EncodeQuaternion(e.q_Ga_Gb);
     w->U8(static_cast<uint8_t>(e.teammate_id));
     w->U8(static_cast<uint8_t>(q.largest |
                                (e.source == ExtrinsicSource::kGraph ? kGraphSourceFlag : 0)));
     WriteQuaternion(q, w);
-    WriteVectorF32(e.p_Gj_in_Gi, w);
+    WriteVectorF32(e.p_Gb_in_Ga, w);
     WriteCovariance<6>(e.covariance, w);
   }
 }

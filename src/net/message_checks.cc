@@ -265,8 +265,8 @@ Status Check(const GlobalExtrinsicMessage& m) {
     if (e.source != ExtrinsicSource::kTrajectoryMatch && e.source != ExtrinsicSource::kGraph) {
       c.Fail("source", -1, "has an unknown value");
     }
-    c.UnitQuaternion("q_Gi_Gj", e.q_Gi_Gj);
-    c.Vector32("p_Gj_in_Gi", e.p_Gj_in_Gi);
+    c.UnitQuaternion("q_Ga_Gb", e.q_Ga_Gb);
+    c.Vector32("p_Gb_in_Ga", e.p_Gb_in_Ga);
     c.Covariance<6>("covariance", e.covariance);
   }
   return c.status();

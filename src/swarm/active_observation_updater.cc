@@ -38,7 +38,7 @@ void ActiveObservationUpdater::AddTerms(const UpdaterScan& scan, ObservationGate
     const double share = ObservationShare(so, scan.previous_scan_degenerate, m.degenerated);
     auto factor = std::make_unique<ActiveObservationFactor>(
         o.p_bj_in_bi, j.p_bj_in_Gj, Regularized<3>(o.covariance_m2) / share,
-        Regularized<3>(j.cov_p), R_Gi_bi, T.R_Gi_Gj());
+        Regularized<3>(j.cov_p), R_Gi_bi, T.R_Ga_Gb());
     const Eigen::Vector3d e = factor->Predict(x.ego, T) - o.p_bj_in_bi;
     const Eigen::Matrix3d S = factor->covariance();
     if (gate->Add(std::move(factor), o.drone_id, e, S)) {

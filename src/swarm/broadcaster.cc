@@ -313,13 +313,13 @@ void Broadcaster::SendExtrinsics(Pass* pass) {
     e.teammate_id = id;
     e.source = registry_->teammates()[id].via_graph ? net::ExtrinsicSource::kGraph
                                                     : net::ExtrinsicSource::kTrajectoryMatch;
-    e.q_Gi_Gj = x.teammate(id).q_Gi_Gj.normalized();
-    e.p_Gj_in_Gi = x.teammate(id).p_Gj_in_Gi;
+    e.q_Ga_Gb = x.teammate(id).q_Ga_Gb.normalized();
+    e.p_Gb_in_Ga = x.teammate(id).p_Gb_in_Ga;
     const Segment b = x.layout().TeammateBlock(id);
     e.covariance = P.block<6, 6>(b.offset, b.offset);
     e.covariance = 0.5 * (e.covariance + e.covariance.transpose()).eval();
     extrinsic_rotation_.MarkSent(id, t_k);  // a non-finite one is not retried before its turn
-    if (e.q_Gi_Gj.coeffs().allFinite() && e.p_Gj_in_Gi.allFinite() && e.covariance.allFinite()) {
+    if (e.q_Ga_Gb.coeffs().allFinite() && e.p_Gb_in_Ga.allFinite() && e.covariance.allFinite()) {
       entries.push_back(e);
     }
   }

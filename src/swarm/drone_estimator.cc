@@ -179,7 +179,7 @@ Status DroneEstimator::FrontEnd(lio::ScanContext* scan, lio::UpdateRequest* requ
                                                  p.last_detection_ns, &p.points));
   p.report.detector_points = static_cast<int>(p.points.size());
   for (int id : x.layout().teammate_ids()) {
-    detector_->SetGlobalExtrinsic(id, x.teammate(id).T_Gi_Gj());
+    detector_->SetGlobalExtrinsic(id, x.teammate(id).T_Ga_Gb());
   }
   Eigen::Isometry3d T_Gi_bi = Eigen::Isometry3d::Identity();
   T_Gi_bi.linear() = x.ego.R_G_b();

@@ -24,7 +24,7 @@ void GravityUpdater::AddTerms(const UpdaterScan& scan, ObservationGate* gate,
     const GlobalExtrinsic& T = x.teammate(id);
     auto factor = std::make_unique<GravityAlignmentFactor>(
         g.g_in_Gj, Regularized<3>(g.covariance, 1e-12), options_.gravity_alignment_sigma_m_s2,
-        T.R_Gi_Gj());
+        T.R_Ga_Gb());
     const Eigen::Vector3d e = factor->Predict(x.ego, T);
     const Eigen::Matrix3d S = factor->covariance();
     if (gate->Add(std::move(factor), id, e, S)) {

@@ -8,6 +8,19 @@
 #include "swarmlio/net/wire_format.h"
 
 namespace swarmlio::swarm::internal {
+namespace {
+
+// The one place a received entry's frames get their names: the wire's
+// T_Ga_Gb is the sender j's extrinsic of b = e.teammate_id (T_Gj_Gk, or T_Gj_Gi
+// when b is this drone), its rotation normalized here for every later use.
+GlobalExtrinsic SendersExtrinsic(const net::GlobalExtrinsicEntry& e) {
+  GlobalExtrinsic T_Gj_Gb;
+  T_Gj_Gb.q_Ga_Gb = e.q_Ga_Gb.normalized();
+  T_Gj_Gb.p_Gb_in_Ga = e.p_Gb_in_Ga;
+  return T_Gj_Gb;
+}
+
+}  // namespace
 
 bool MessageInbox::ToLocal(int sender_id, int64_t sender_stamp_ns, int64_t* local_ns) const {
   *local_ns = sender_stamp_ns;
@@ -67,8 +80,8 @@ void MessageInbox::OnExtrinsics(const net::GlobalExtrinsicMessage& g, const OwnS
     return;
   }
   for (const net::GlobalExtrinsicEntry& e : g.entries) {
-    if (!e.q_Gi_Gj.coeffs().allFinite() || !e.p_Gj_in_Gi.allFinite() ||
-        !e.covariance.allFinite() || e.teammate_id < 0) {
+    if (!e.q_Ga_Gb.coeffs().allFinite() || !e.p_Gb_in_Ga.allFinite() || !e.covariance.allFinite() ||
+        e.teammate_id < 0) {
       continue;
     }
     if (e.teammate_id == self_id_) {
@@ -76,7 +89,11 @@ void MessageInbox::OnExtrinsics(const net::GlobalExtrinsicMessage& g, const OwnS
       // session: after a restart, teammates keep broadcasting the old one
       // until they hear the new session (its first states, one latency).
       if (MadeInThisSession(g.sender_id, g.stamp_ns, own)) {
-        to_.registry->SetMutual(g.sender_id, e);
+        PendingMutual mutual;
+        mutual.T_Gj_Gi = SendersExtrinsic(e);
+        mutual.cov_T_Gj_Gi = e.covariance;
+        mutual.source = e.source;
+        to_.registry->SetMutual(g.sender_id, mutual);
       } else {
         ++to_.counters->extrinsics_stale;
       }
@@ -84,7 +101,10 @@ void MessageInbox::OnExtrinsics(const net::GlobalExtrinsicMessage& g, const OwnS
       // Likewise about a third drone k that restarted: the sender keeps
       // its T_Gj_Gk of k's old G_k until it hears k's new session.
       if (MadeInSessionOf(e.teammate_id, g.sender_id, g.stamp_ns)) {
-        to_.registry->teammates()[g.sender_id].identified[e.teammate_id] = e;
+        TeammateMatch match;
+        match.T_Gj_Gk = SendersExtrinsic(e);
+        match.cov_T_Gj_Gk = e.covariance;
+        to_.registry->teammates()[g.sender_id].identified[e.teammate_id] = match;
       } else {
         ++to_.counters->extrinsics_stale;
       }

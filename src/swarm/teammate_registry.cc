@@ -69,9 +69,9 @@ void TeammateRegistry::AddMatched(int64_t t_k, const teammate::ScanResult& detec
   const SwarmOptions& so = options_;
   for (const teammate::TeammateIdentification& id : detection.identifications) {
     if (x->HasTeammate(id.drone_id)) continue;
-    GlobalExtrinsic T;
-    T.q_Gi_Gj = Eigen::Quaterniond(id.R_Gi_Gj).normalized();
-    T.p_Gj_in_Gi = id.p_Gj_in_Gi;
+    GlobalExtrinsic T_Gi_Gj;
+    T_Gi_Gj.q_Ga_Gb = Eigen::Quaterniond(id.R_Gi_Gj).normalized();
+    T_Gi_Gj.p_Gb_in_Ga = id.p_Gj_in_Gi;
     const double sigma_p = std::max(so.init_translation_sigma_floor_m,
                                     so.init_translation_sigma_per_residual * id.mean_residual_m);
     // The excitation flights span about a metre: a translation error sigma_p
@@ -80,9 +80,9 @@ void TeammateRegistry::AddMatched(int64_t t_k, const teammate::ScanResult& detec
     Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
     C.diagonal().head<3>().setConstant(sigma_r * sigma_r);
     C.diagonal().tail<3>().setConstant(sigma_p * sigma_p);
-    AddBlock(id.drone_id, t_k, T, C, x, P);
+    AddBlock(id.drone_id, t_k, T_Gi_Gj, C, x, P);
     SetProvenance(false, {}, &teammates_[id.drone_id]);
-    IdentificationEvent event = Event(id.drone_id, t_k, "trajectory_match", T);
+    IdentificationEvent event = Event(id.drone_id, t_k, "trajectory_match", T_Gi_Gj);
     event.mean_residual_m = id.mean_residual_m;
     report->identifications.push_back(event);
   }
@@ -92,28 +92,28 @@ void TeammateRegistry::AddMutual(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P,
                                  ScanReport* report) {
   for (const auto& [j, pending] : mutual_) {
     if (x->HasTeammate(j) || teammates_[j].restarted) continue;
-    GlobalExtrinsic T;
+    GlobalExtrinsic T_Gi_Gj;
     Eigen::Matrix<double, 6, 6> C;
-    InvertExtrinsic(pending.entry, &T, &C);
-    if (!detector_->AddIdentifiedTeammate(j, t_k, T.R_Gi_Gj(), T.p_Gj_in_Gi)) continue;
+    InvertExtrinsic(pending.T_Gj_Gi, pending.cov_T_Gj_Gi, &T_Gi_Gj, &C);
+    if (!detector_->AddIdentifiedTeammate(j, t_k, T_Gi_Gj.R_Ga_Gb(), T_Gi_Gj.p_Gb_in_Ga)) continue;
     // Positive definite whatever arrived, and at least the covariance of an
     // own match with zero residual.
     C = Regularized<6>(C, 1e-10);
     ApplySigmaFloors(options_, &C);
-    AddBlock(j, t_k, T, C, x, P);
+    AddBlock(j, t_k, T_Gi_Gj, C, x, P);
     // The inverse of an edge j derived itself stays derived, through
     // teammates j did not name: any teammate heard so far may be in its chain.
-    const bool derived = pending.entry.source == net::ExtrinsicSource::kGraph;
+    const bool derived = pending.source == net::ExtrinsicSource::kGraph;
     SetProvenance(derived, derived ? HeardTeammates(teammates_, j) : std::map<int, int64_t>(),
                   &teammates_[j]);
-    report->identifications.push_back(Event(j, t_k, "teammate_match", T));
+    report->identifications.push_back(Event(j, t_k, "teammate_match", T_Gi_Gj));
   }
 }
 
 void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P,
                                            ScanReport* report) {
   struct Candidate {
-    GlobalExtrinsic T;
+    GlobalExtrinsic T_Gi_Gk;
     Eigen::Matrix<double, 6, 6> J_ij;
     Eigen::Matrix<double, 6, 6> C;  // J_ij P_ij J_ij^T + J_jk C_jk J_jk^T
     int via = -1;
@@ -126,18 +126,15 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
     if (!CanRelay(info_j, *x, teammates_, options_)) continue;
     const Segment bj = x->layout().TeammateBlock(j);
     const Eigen::Matrix<double, 6, 6> P_ij = P->block<6, 6>(bj.offset, bj.offset);
-    for (const auto& [k, e] : info_j.identified) {
+    for (const auto& [k, match] : info_j.identified) {
       if (k == self_id_ || x->HasTeammate(k)) continue;
       if (ChainPassesThrough(info_j, k, teammates_)) continue;
       const auto it_k = teammates_.find(k);
       if (it_k != teammates_.end() && it_k->second.restarted) continue;
-      GlobalExtrinsic T_jk;
-      T_jk.q_Gi_Gj = e.q_Gi_Gj.normalized();
-      T_jk.p_Gj_in_Gi = e.p_Gj_in_Gi;
       Candidate c;
       Eigen::Matrix<double, 6, 6> J_jk;
-      ComposeExtrinsic(x->teammate(j), T_jk, &c.T, &c.J_ij, &J_jk);
-      const Eigen::Matrix<double, 6, 6> C_jk = Regularized<6>(e.covariance, 1e-10);
+      ComposeExtrinsic(x->teammate(j), match.T_Gj_Gk, &c.T_Gi_Gk, &c.J_ij, &J_jk);
+      const Eigen::Matrix<double, 6, 6> C_jk = Regularized<6>(match.cov_T_Gj_Gk, 1e-10);
       c.C = c.J_ij * P_ij * c.J_ij.transpose() + J_jk * C_jk * J_jk.transpose();
       c.via = j;
       const auto it = best.find(k);
@@ -145,7 +142,9 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
     }
   }
   for (const auto& [k, c] : best) {
-    if (!detector_->AddIdentifiedTeammate(k, t_k, c.T.R_Gi_Gj(), c.T.p_Gj_in_Gi)) continue;
+    if (!detector_->AddIdentifiedTeammate(k, t_k, c.T_Gi_Gk.R_Ga_Gb(), c.T_Gi_Gk.p_Gb_in_Ga)) {
+      continue;
+    }
     // Cross-covariances: d(T_ik) = J_ij d(T_ij) + J_jk d(T_jk) with d(T_jk)
     // independent of this drone's state, so P(k, :) = J_ij P(j, :).
     const int n = static_cast<int>(P->rows());
@@ -153,14 +152,14 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
     const Eigen::MatrixXd cross = c.J_ij * P->middleRows(bj.offset, 6);
     Eigen::Matrix<double, 6, 6> C = 0.5 * (c.C + c.C.transpose());
     ApplySigmaFloors(options_, &C);
-    AddBlock(k, t_k, c.T, C, x, P);
+    AddBlock(k, t_k, c.T_Gi_Gk, C, x, P);
     P->block(n, 0, 6, n) = cross;
     P->block(0, n, n, 6) = cross.transpose();
     // k's chain: j's (empty when j is first-hand) and j itself.
     std::map<int, int64_t> through = teammates_[c.via].derived_through;
     through[c.via] = teammates_[c.via].session_start_ns;
     SetProvenance(true, std::move(through), &teammates_[k]);
-    IdentificationEvent event = Event(k, t_k, "graph", c.T);
+    IdentificationEvent event = Event(k, t_k, "graph", c.T_Gi_Gk);
     event.via_drone_id = c.via;
     report->identifications.push_back(event);
   }
@@ -200,10 +199,10 @@ std::vector<TeammateEstimate> TeammateRegistry::Estimates(int64_t t_k, const Swa
     if (info.have_message &&
         std::abs(ToSeconds(t_k - info.last.stamp_ns)) <= options_.max_message_age_s) {
       const PredictedTeammate j = Predict(info.last, ToSeconds(t_k - info.last.stamp_ns));
-      const Eigen::Matrix3d R_Gi_Gj = e.T_Gi_Gj.R_Gi_Gj();
+      const Eigen::Matrix3d R_Gi_Gj = e.T_Gi_Gj.R_Ga_Gb();
       e.have_pose = true;
       e.q_Gi_bj = Eigen::Quaterniond(R_Gi_Gj * j.R_Gj_bj).normalized();
-      e.p_bj_in_Gi = R_Gi_Gj * j.p_bj_in_Gj + e.T_Gi_Gj.p_Gj_in_Gi;
+      e.p_bj_in_Gi = R_Gi_Gj * j.p_bj_in_Gj + e.T_Gi_Gj.p_Gb_in_Ga;
       e.v_bj_in_Gi = R_Gi_Gj * j.v_bj_in_Gj;
     }
     e.seen = info.last_seen_ns == t_k;

@@ -32,9 +32,7 @@ class TeammateRegistry {
   const Teammates& teammates() const { return teammates_; }
 
   /// Teammate `sender` identified this drone: its T_Gj_Gi, used at the next scan.
-  void SetMutual(int sender, const net::GlobalExtrinsicEntry& entry) {
-    mutual_[sender] = PendingMutual{entry};
-  }
+  void SetMutual(int sender, const PendingMutual& mutual) { mutual_[sender] = mutual; }
   void ForgetMutual(int sender) { mutual_.erase(sender); }
 
   /// The scan at t_k: blocks of newly identified teammates in (their events

@@ -67,29 +67,31 @@ PredictedTeammate Predict(const net::EgoStateMessage& m, double dt) {
 
 void ComposeExtrinsic(const GlobalExtrinsic& T_ij, const GlobalExtrinsic& T_jk, GlobalExtrinsic* T_ik,
                       Eigen::Matrix<double, 6, 6>* J_ij, Eigen::Matrix<double, 6, 6>* J_jk) {
-  const Eigen::Matrix3d R_ij = T_ij.R_Gi_Gj();
-  const Eigen::Matrix3d R_jk = T_jk.R_Gi_Gj();
-  T_ik->q_Gi_Gj = (T_ij.q_Gi_Gj.normalized() * T_jk.q_Gi_Gj.normalized()).normalized();
-  T_ik->p_Gj_in_Gi = R_ij * T_jk.p_Gj_in_Gi + T_ij.p_Gj_in_Gi;
+  const Eigen::Matrix3d R_ij = T_ij.R_Ga_Gb();
+  const Eigen::Matrix3d R_jk = T_jk.R_Ga_Gb();
+  T_ik->q_Ga_Gb = (T_ij.q_Ga_Gb.normalized() * T_jk.q_Ga_Gb.normalized()).normalized();
+  T_ik->p_Gb_in_Ga = R_ij * T_jk.p_Gb_in_Ga + T_ij.p_Gb_in_Ga;
   J_ij->setZero();
   J_ij->topLeftCorner<3, 3>() = R_jk.transpose();
-  J_ij->bottomLeftCorner<3, 3>() = -R_ij * so3::Hat(T_jk.p_Gj_in_Gi);
+  J_ij->bottomLeftCorner<3, 3>() = -R_ij * so3::Hat(T_jk.p_Gb_in_Ga);
   J_ij->bottomRightCorner<3, 3>().setIdentity();
   J_jk->setZero();
   J_jk->topLeftCorner<3, 3>().setIdentity();
   J_jk->bottomRightCorner<3, 3>() = R_ij;
 }
 
-void InvertExtrinsic(const net::GlobalExtrinsicEntry& e, GlobalExtrinsic* T,
-                     Eigen::Matrix<double, 6, 6>* C) {
-  const Eigen::Matrix3d R = e.q_Gi_Gj.normalized().toRotationMatrix();
-  T->q_Gi_Gj = e.q_Gi_Gj.normalized().conjugate();
-  T->p_Gj_in_Gi = -(R.transpose() * e.p_Gj_in_Gi);
+void InvertExtrinsic(const GlobalExtrinsic& T_Gj_Gi,
+                     const Eigen::Matrix<double, 6, 6>& cov_T_Gj_Gi,
+                     GlobalExtrinsic* T_Gi_Gj,
+                     Eigen::Matrix<double, 6, 6>* cov_T_Gi_Gj) {
+  const Eigen::Matrix3d R = T_Gj_Gi.R_Ga_Gb();  // R_Gj_Gi
+  T_Gi_Gj->q_Ga_Gb = T_Gj_Gi.q_Ga_Gb.conjugate();
+  T_Gi_Gj->p_Gb_in_Ga = -(R.transpose() * T_Gj_Gi.p_Gb_in_Ga);
   Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
   J.topLeftCorner<3, 3>() = -R;
-  J.bottomLeftCorner<3, 3>() = so3::Hat(T->p_Gj_in_Gi);
+  J.bottomLeftCorner<3, 3>() = so3::Hat(T_Gi_Gj->p_Gb_in_Ga);
   J.bottomRightCorner<3, 3>() = -R.transpose();
-  *C = J * e.covariance * J.transpose();
+  *cov_T_Gi_Gj = J * cov_T_Gj_Gi * J.transpose();
 }
 
 }  // namespace swarmlio::swarm::internal

@@ -20,6 +20,14 @@ namespace swarmlio::swarm::internal {
 /// The message is finite in every field the estimator uses.
 bool Finite(const net::EgoStateMessage& m);
 
+/// Teammate j's own trajectory match of its teammate k, from j's
+/// GlobalExtrinsicMessage entry about k (named by frames at the inbox).
+struct TeammateMatch {
+  GlobalExtrinsic T_Gj_Gk;  // its rotation normalized at the inbox
+  /// Covariance of [dtheta (rad); dp (m)], R_Gj_Gk = R^ Exp(dtheta), as sent.
+  Eigen::Matrix<double, 6, 6> cov_T_Gj_Gk = Eigen::Matrix<double, 6, 6>::Zero();
+};
+
 struct TeammateInfo {
   bool have_message = false;
   net::EgoStateMessage last;       // the newest received state
@@ -44,7 +52,7 @@ struct TeammateInfo {
   // j's own trajectory matches T_Gj_Gk, by k (from its GlobalExtrinsic
   // broadcasts; kTrajectoryMatch entries only: j's derived edges are never
   // composed here, j cannot tell through whom it derived them).
-  std::map<int, net::GlobalExtrinsicEntry> identified;
+  std::map<int, TeammateMatch> identified;
 };
 
 using Teammates = std::map<int, TeammateInfo>;
@@ -110,14 +118,22 @@ struct PendingPassive {
   net::EgoStateMessage sender;  // j's state at that time
 };
 
-// A teammate's T_Gj_Gi (it identified this drone), waiting for the next scan.
+// A teammate j's T_Gj_Gi (it identified this drone), waiting for the next
+// scan: its GlobalExtrinsicMessage entry about this drone, named by frames at
+// the inbox.
 struct PendingMutual {
-  net::GlobalExtrinsicEntry entry;  // entry.teammate_id == this drone
+  GlobalExtrinsic T_Gj_Gi;  // its rotation normalized at the inbox
+  // Covariance of [dtheta (rad); dp (m)], R_Gj_Gi = R^ Exp(dtheta), as sent.
+  Eigen::Matrix<double, 6, 6> cov_T_Gj_Gi = Eigen::Matrix<double, 6, 6>::Zero();
+  net::ExtrinsicSource source = net::ExtrinsicSource::kTrajectoryMatch;  // how j got it
 };
 
 // T_Gi_Gj = T_Gj_Gi^-1 with the covariance mapped to the inverse's error
 // state (R Exp(theta), p + dp): theta' = -R theta, dp' = [p']x theta - R^T dp.
-void InvertExtrinsic(const net::GlobalExtrinsicEntry& e, GlobalExtrinsic* T,
-                     Eigen::Matrix<double, 6, 6>* C);
+// T_Gj_Gi's rotation must be unit (PendingMutual's is).
+void InvertExtrinsic(const GlobalExtrinsic& T_Gj_Gi,
+                     const Eigen::Matrix<double, 6, 6>& cov_T_Gj_Gi,
+                     GlobalExtrinsic* T_Gi_Gj,
+                     Eigen::Matrix<double, 6, 6>* cov_T_Gi_Gj);
 
 }  // namespace swarmlio::swarm::internal

@@ -29,8 +29,8 @@ SwarmState RandomState(std::mt19937& rng, const std::vector<int>& ids) {
   x.ego.g_in_G = RandomVector(rng, 1) + Eigen::Vector3d(0, 0, -9.81);
   for (int id : ids) {
     GlobalExtrinsic e;
-    e.q_Gi_Gj = RandomRotation(rng);
-    e.p_Gj_in_Gi = RandomVector(rng, 5);
+    e.q_Ga_Gb = RandomRotation(rng);
+    e.p_Gb_in_Ga = RandomVector(rng, 5);
     x.AddTeammate(id, e);
   }
   return x;
@@ -56,12 +56,12 @@ TEST(SwarmState, BoxPlusMatchesThePaperDefinition) {
   EXPECT_TRUE(y.ego.g_in_G.isApprox(x.ego.g_in_G + dx.segment<3>(L::kGravity.offset)));
   const Segment rot1 = x.layout().TeammateRotation(1);
   const Segment trans1 = x.layout().TeammateTranslation(1);
-  EXPECT_NEAR((y.teammate(1).R_Gi_Gj() -
-               x.teammate(1).R_Gi_Gj() * so3::Exp(dx.segment<3>(rot1.offset)))
-                  .norm(),
-              0.0, 1e-14);
-  EXPECT_TRUE(y.teammate(1).p_Gj_in_Gi.isApprox(x.teammate(1).p_Gj_in_Gi +
-                                                 dx.segment<3>(trans1.offset)));
+  EXPECT_NEAR(
+      (y.teammate(1).R_Ga_Gb() - x.teammate(1).R_Ga_Gb() * so3::Exp(dx.segment<3>(rot1.offset)))
+          .norm(),
+      0.0, 1e-14);
+  EXPECT_TRUE(
+      y.teammate(1).p_Gb_in_Ga.isApprox(x.teammate(1).p_Gb_in_Ga + dx.segment<3>(trans1.offset)));
 }
 
 TEST(SwarmState, BoxMinusInvertsBoxPlus) {
@@ -107,7 +107,7 @@ TEST(SwarmState, RemovingATeammateKeepsTheOthers) {
   x.RemoveTeammate(2);
   EXPECT_EQ(x.Dim(), 30);
   EXPECT_FALSE(x.HasTeammate(2));
-  EXPECT_EQ(x.teammate(3).p_Gj_in_Gi, e3.p_Gj_in_Gi);
+  EXPECT_EQ(x.teammate(3).p_Gb_in_Ga, e3.p_Gb_in_Ga);
   EXPECT_EQ(x.layout().TeammateBlock(3).offset, 24);
 }
 

@@ -25,7 +25,7 @@ using Sampler = swarmlio::testing::StateSampler;
 Eigen::Vector3d ActivePrediction(const EgoState& ego,
                                  const GlobalExtrinsic& T,
                                  const Eigen::Vector3d& p_bj_in_Gj) {
-  const Eigen::Vector3d p_bj_in_Gi = T.R_Gi_Gj() * p_bj_in_Gj + T.p_Gj_in_Gi;
+  const Eigen::Vector3d p_bj_in_Gi = T.R_Ga_Gb() * p_bj_in_Gj + T.p_Gb_in_Ga;
   return ego.R_G_b().transpose() * (p_bj_in_Gi - ego.p_b_in_G);
 }
 
@@ -47,7 +47,7 @@ struct Problem {
     Sigma_obs = s->Covariance3(0.1, 1e-3);
     Sigma_p = s->Covariance3(0.1, 1e-3);
     R_Gi_bi_lin = ego.R_G_b() * so3::Exp(s->Gaussian3(0.02));
-    R_Gi_Gj_lin = extrinsic.R_Gi_Gj() * so3::Exp(s->Gaussian3(0.02));
+    R_Gi_Gj_lin = extrinsic.R_Ga_Gb() * so3::Exp(s->Gaussian3(0.02));
   }
   ActiveObservationFactor Factor() const {
     return ActiveObservationFactor(z, p_bj_in_Gj, Sigma_obs, Sigma_p, R_Gi_bi_lin, R_Gi_Gj_lin);
@@ -185,7 +185,7 @@ TEST(ActiveObservationFactor, TangentJacobianIsTheStatedFormula) {
     H_ego.block<3, 3>(0, 0) = so3::Hat(h);
     H_ego.block<3, 3>(0, 3) = -Rt;
     Eigen::Matrix<double, 3, 6> H_ext;
-    H_ext.leftCols<3>() = -Rt * pr.extrinsic.R_Gi_Gj() * so3::Hat(pr.p_bj_in_Gj);
+    H_ext.leftCols<3>() = -Rt * pr.extrinsic.R_Ga_Gb() * so3::Hat(pr.p_bj_in_Gj);
     H_ext.rightCols<3>() = Rt;
     EXPECT_TRUE(testing::MatricesNear(U * J_ego, H_ego, 1e-10, 1e-12));
     EXPECT_TRUE(testing::MatricesNear(U * J_ext, H_ext, 1e-10, 1e-12));

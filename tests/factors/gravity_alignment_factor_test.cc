@@ -31,10 +31,10 @@ struct Problem {
 
   Problem(Sampler* s, double ego_angle, double ext_angle, bool exact)
       : ego(s->Ego(ego_angle)), extrinsic(s->Extrinsic(ext_angle)) {
-    g_in_Gj = extrinsic.R_Gi_Gj().transpose() * ego.g_in_G;
+    g_in_Gj = extrinsic.R_Ga_Gb().transpose() * ego.g_in_G;
     if (!exact) g_in_Gj += s->Gaussian3(0.05);
     Sigma_g = s->Covariance3(0.01, 1e-5);
-    R_lin = extrinsic.R_Gi_Gj() * so3::Exp(s->Gaussian3(0.02));
+    R_lin = extrinsic.R_Ga_Gb() * so3::Exp(s->Gaussian3(0.02));
   }
   GravityAlignmentFactor Factor() const {
     return GravityAlignmentFactor(g_in_Gj, Sigma_g, floor, R_lin);
@@ -68,7 +68,7 @@ TEST(GravityAlignmentFactor, ZeroAtConsistentGravityAndTheMahalanobisDistanceEls
     const GravityAlignmentFactor factor = pr.Factor();
     const EgoState ego = s.Ego(-1.0);
     const GlobalExtrinsic ext = s.Extrinsic(-1.0);
-    const Eigen::Vector3d e = ext.R_Gi_Gj() * pr.g_in_Gj - ego.g_in_G;
+    const Eigen::Vector3d e = ext.R_Ga_Gb() * pr.g_in_Gj - ego.g_in_G;
     const double m2 = e.dot(pr.S().ldlt().solve(e));
     const Blocks b(ego, ext);
     Eigen::Vector3d r;
@@ -121,7 +121,7 @@ TEST(GravityAlignmentFactor, TangentJacobianIsTheStatedFormulaAndNumeric) {
     Eigen::Matrix<double, 3, 18> H_ego = Eigen::Matrix<double, 3, 18>::Zero();
     H_ego.block<3, 3>(0, 15) = -Eigen::Matrix3d::Identity();
     Eigen::Matrix<double, 3, 6> H_ext = Eigen::Matrix<double, 3, 6>::Zero();
-    H_ext.leftCols<3>() = -pr.extrinsic.R_Gi_Gj() * so3::Hat(pr.g_in_Gj);
+    H_ext.leftCols<3>() = -pr.extrinsic.R_Ga_Gb() * so3::Hat(pr.g_in_Gj);
     EXPECT_TRUE(testing::MatricesNear(U * J_ego, H_ego, 1e-10, 1e-12));
     EXPECT_TRUE(testing::MatricesNear(U * J_ext, H_ext, 1e-10, 1e-12));
     Eigen::Matrix<double, 3, 24> J;

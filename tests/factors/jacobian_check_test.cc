@@ -21,9 +21,9 @@ class TransformPointCost final : public ceres::SizedCostFunction<3, 7> {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     const GlobalExtrinsic T = GlobalExtrinsic::FromParameters(parameters[0]);
-    const Eigen::Matrix3d R = T.R_Gi_Gj();
+    const Eigen::Matrix3d R = T.R_Ga_Gb();
     Eigen::Map<Eigen::Vector3d> r(residuals);
-    r = R * a_ + T.p_Gj_in_Gi - b_;
+    r = R * a_ + T.p_Gb_in_Ga - b_;
     if (jacobians == nullptr || jacobians[0] == nullptr) return true;
     Eigen::Matrix3d J_rot = -R * so3::Hat(a_);
     if (mode_ == Mode::kFlippedRotationSign) J_rot = -J_rot;
@@ -43,8 +43,8 @@ class JacobianCheckTest : public ::testing::Test {
  protected:
   void SetUp() override {
     GlobalExtrinsic T;
-    T.q_Gi_Gj = so3::ExpQuaternion(Eigen::Vector3d(0.3, -1.1, 0.7));
-    T.p_Gj_in_Gi = Eigen::Vector3d(1.0, 2.0, -0.5);
+    T.q_Ga_Gb = so3::ExpQuaternion(Eigen::Vector3d(0.3, -1.1, 0.7));
+    T.p_Gb_in_Ga = Eigen::Vector3d(1.0, 2.0, -0.5);
     T.ToParameters(x_);
   }
   bool Check(TransformPointCost::Mode mode) {

@@ -42,7 +42,7 @@ Eigen::Vector3d PassivePrediction(const EgoState& ego,
                                   const EgoState& lin = EgoState()) {
   const Eigen::Vector3d p_bi_in_Gi_at_tj =
       ego.p_b_in_G + ego.v_b_in_G * dt + RetrodictedA(ego, r, lin);
-  const Eigen::Vector3d p_bi_in_Gj = T.R_Gi_Gj().transpose() * (p_bi_in_Gi_at_tj - T.p_Gj_in_Gi);
+  const Eigen::Vector3d p_bi_in_Gj = T.R_Ga_Gb().transpose() * (p_bi_in_Gi_at_tj - T.p_Gb_in_Ga);
   return R_Gj_bj.transpose() * (p_bi_in_Gj - p_bj_in_Gj);
 }
 
@@ -268,11 +268,11 @@ TEST(PassiveObservationFactor, TangentJacobianIsTheStatedFormula) {
     Eigen::Matrix<double, 3, 6> J_ext;
     factor.TangentJacobian(pr.ego, pr.extrinsic, &J_ego, &J_ext);
     const Eigen::Matrix3d U = pr.S().llt().matrixL();
-    const Eigen::Matrix3d R_e = pr.extrinsic.R_Gi_Gj();
+    const Eigen::Matrix3d R_e = pr.extrinsic.R_Ga_Gb();
     const Eigen::Matrix3d M = pr.R_Gj_bj.transpose() * R_e.transpose();
     const Eigen::Vector3d w =
         R_e.transpose() * (pr.ego.p_b_in_G + pr.ego.v_b_in_G * pr.dt +
-                           RetrodictedA(pr.ego, pr.r, pr.ego_lin) - pr.extrinsic.p_Gj_in_Gi);
+                           RetrodictedA(pr.ego, pr.r, pr.ego_lin) - pr.extrinsic.p_Gb_in_Ga);
     // c = u + M_r (b_a0 - b_a), with u and M_r formed at ego_lin.
     const Eigen::Matrix3d R0_T = pr.ego_lin.R_G_b().transpose();
     const Eigen::Matrix3d M_r = R0_T * pr.r.weighted_R_G_b;

@@ -59,13 +59,13 @@ Eigen::Matrix3d Whitening(const Eigen::Matrix3d& S) {
 void ActiveRows(const SwarmState& x, const Active& a, Eigen::MatrixXd* H, Eigen::VectorXd* z) {
   const Eigen::Matrix3d R_bi = x.ego.R_G_b();
   const GlobalExtrinsic& T = x.teammate(a.j);
-  const Eigen::Vector3d h = R_bi.transpose() * (T.R_Gi_Gj() * a.p_bj_in_Gj + T.p_Gj_in_Gi -
-                                                x.ego.p_b_in_G);
+  const Eigen::Vector3d h =
+      R_bi.transpose() * (T.R_Ga_Gb() * a.p_bj_in_Gj + T.p_Gb_in_Ga - x.ego.p_b_in_G);
   Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(3, x.Dim());
   rows.block<3, 3>(0, 0) = so3::Hat(h);
   rows.block<3, 3>(0, 3) = -R_bi.transpose();
   const int o = x.layout().TeammateBlock(a.j).offset;
-  rows.block<3, 3>(0, o) = -R_bi.transpose() * T.R_Gi_Gj() * so3::Hat(a.p_bj_in_Gj);
+  rows.block<3, 3>(0, o) = -R_bi.transpose() * T.R_Ga_Gb() * so3::Hat(a.p_bj_in_Gj);
   rows.block<3, 3>(0, o + 3) = R_bi.transpose();
   const Eigen::Matrix3d W = Whitening(a.S);
   H->conservativeResize(H->rows() + 3, x.Dim());
@@ -78,9 +78,9 @@ void ActiveRows(const SwarmState& x, const Active& a, Eigen::MatrixXd* H, Eigen:
 void PassiveRows(const SwarmState& x, const Passive& p, Eigen::MatrixXd* H, Eigen::VectorXd* z) {
   const GlobalExtrinsic& T = x.teammate(p.j);
   const Eigen::Vector3d w =
-      T.R_Gi_Gj().transpose() * (x.ego.p_b_in_G + x.ego.v_b_in_G * p.dt - T.p_Gj_in_Gi);
+      T.R_Ga_Gb().transpose() * (x.ego.p_b_in_G + x.ego.v_b_in_G * p.dt - T.p_Gb_in_Ga);
   const Eigen::Vector3d h = p.R_Gj_bj.transpose() * (w - p.p_bj_in_Gj);
-  const Eigen::Matrix3d M = p.R_Gj_bj.transpose() * T.R_Gi_Gj().transpose();
+  const Eigen::Matrix3d M = p.R_Gj_bj.transpose() * T.R_Ga_Gb().transpose();
   Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(3, x.Dim());
   rows.block<3, 3>(0, 3) = M;
   rows.block<3, 3>(0, 6) = M * p.dt;
@@ -125,13 +125,12 @@ void MakeProblem(unsigned seed, bool third, const std::vector<int>& observed, Pr
       Active a;
       a.j = j;
       const Eigen::Vector3d p_bj_in_Gi = e.p_b_in_G + s.Gaussian(3, 4.0);
-      a.p_bj_in_Gj = T.R_Gi_Gj().transpose() * (p_bj_in_Gi - T.p_Gj_in_Gi);
+      a.p_bj_in_Gj = T.R_Ga_Gb().transpose() * (p_bj_in_Gi - T.p_Gb_in_Ga);
       a.z = e.R_G_b().transpose() * (p_bj_in_Gi - e.p_b_in_G) + s.Gaussian(3, 0.02);
       const Eigen::Matrix3d obs = Spd(&s, 0.03), cov_p = Spd(&s, 0.02);
-      auto f = std::make_unique<ActiveObservationFactor>(a.z, a.p_bj_in_Gj, obs, cov_p,
-                                                         pr->x_hat.ego.R_G_b(),
-                                                         pr->x_hat.teammate(j).R_Gi_Gj());
-      const Eigen::Matrix3d A = pr->x_hat.ego.R_G_b().transpose() * pr->x_hat.teammate(j).R_Gi_Gj();
+      auto f = std::make_unique<ActiveObservationFactor>(
+          a.z, a.p_bj_in_Gj, obs, cov_p, pr->x_hat.ego.R_G_b(), pr->x_hat.teammate(j).R_Ga_Gb());
+      const Eigen::Matrix3d A = pr->x_hat.ego.R_G_b().transpose() * pr->x_hat.teammate(j).R_Ga_Gb();
       a.S = obs + A * cov_p * A.transpose();
       pr->terms.terms_.push_back({f.get(), {StateKey::Ego(), StateKey::Extrinsic(j)}});
       pr->costs.push_back(std::move(f));
@@ -143,16 +142,18 @@ void MakeProblem(unsigned seed, bool third, const std::vector<int>& observed, Pr
     p.R_Gj_bj = s.Rotation().toRotationMatrix();
     const Eigen::Vector3d p_bi_at_tj = e.p_b_in_G + e.v_b_in_G * p.dt;
     const Eigen::Vector3d p_bj_in_Gi = p_bi_at_tj + s.Gaussian(3, 4.0);
-    p.p_bj_in_Gj = T.R_Gi_Gj().transpose() * (p_bj_in_Gi - T.p_Gj_in_Gi);
-    p.z = p.R_Gj_bj.transpose() * (T.R_Gi_Gj().transpose() * (p_bi_at_tj - T.p_Gj_in_Gi) -
-                                   p.p_bj_in_Gj) + s.Gaussian(3, 0.02);
+    p.p_bj_in_Gj = T.R_Ga_Gb().transpose() * (p_bj_in_Gi - T.p_Gb_in_Ga);
+    p.z = p.R_Gj_bj.transpose() *
+              (T.R_Ga_Gb().transpose() * (p_bi_at_tj - T.p_Gb_in_Ga) - p.p_bj_in_Gj) +
+          s.Gaussian(3, 0.02);
     const Eigen::Matrix3d obs = Spd(&s, 0.03), cov_th = Spd(&s, 0.005), cov_p = Spd(&s, 0.02);
     auto f = std::make_unique<PassiveObservationFactor>(p.z, p.dt, p.R_Gj_bj, p.p_bj_in_Gj, obs,
                                                         cov_th, cov_p, pr->x_hat.ego,
                                                         pr->x_hat.teammate(j));
     const SwarmState& xh = pr->x_hat;
-    const Eigen::Vector3d w0 = xh.teammate(j).R_Gi_Gj().transpose() *
-                               (xh.ego.p_b_in_G + xh.ego.v_b_in_G * p.dt - xh.teammate(j).p_Gj_in_Gi);
+    const Eigen::Vector3d w0 =
+        xh.teammate(j).R_Ga_Gb().transpose() *
+        (xh.ego.p_b_in_G + xh.ego.v_b_in_G * p.dt - xh.teammate(j).p_Gb_in_Ga);
     const Eigen::Vector3d h0 = p.R_Gj_bj.transpose() * (w0 - p.p_bj_in_Gj);
     p.S = obs + so3::Hat(h0) * cov_th * so3::Hat(h0).transpose() +
           p.R_Gj_bj.transpose() * cov_p * p.R_Gj_bj;
@@ -271,7 +272,7 @@ TEST(EsikfMutualUpdate, SubsetUpdateIsTheSchmidtKalmanUpdate) {
   // The blocks left out kept their estimate and marginal covariance.
   for (int id : {2, 12}) {
     const Segment b = pr.x_hat.layout().TeammateBlock(id);
-    EXPECT_EQ(result.state.teammate(id).p_Gj_in_Gi, pr.x_hat.teammate(id).p_Gj_in_Gi);
+    EXPECT_EQ(result.state.teammate(id).p_Gb_in_Ga, pr.x_hat.teammate(id).p_Gb_in_Ga);
     EXPECT_EQ(MaxAbs(result.covariance.block(b.offset, b.offset, 6, 6) -
                      pr.P.block(b.offset, b.offset, 6, 6)),
               0.0);
@@ -308,8 +309,7 @@ TEST(EsikfMutualUpdate, ConsideredBlocksEnterTheGainAndStayUncorrected) {
   const EsikfUpdateResult joint =
       EsikfUpdate().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &both);
   ASSERT_TRUE(joint.status.ok());
-  EXPECT_GT((joint.state.teammate(12).p_Gj_in_Gi - pr.x_hat.teammate(12).p_Gj_in_Gi).norm(),
-            1e-3);
+  EXPECT_GT((joint.state.teammate(12).p_Gb_in_Ga - pr.x_hat.teammate(12).p_Gb_in_Ga).norm(), 1e-3);
 
   const int n = pr.x_hat.Dim();
   const ErrorStateLayout& layout = pr.x_hat.layout();
@@ -331,8 +331,8 @@ TEST(EsikfMutualUpdate, ConsideredBlocksEnterTheGainAndStayUncorrected) {
   // Block 12: mean, marginal covariance, cross-covariance with block 2 kept.
   const Segment b12 = layout.TeammateBlock(12);
   const Segment b2 = layout.TeammateBlock(2);
-  EXPECT_EQ(result.state.teammate(12).p_Gj_in_Gi, pr.x_hat.teammate(12).p_Gj_in_Gi);
-  EXPECT_EQ(result.state.teammate(12).q_Gi_Gj.coeffs(), pr.x_hat.teammate(12).q_Gi_Gj.coeffs());
+  EXPECT_EQ(result.state.teammate(12).p_Gb_in_Ga, pr.x_hat.teammate(12).p_Gb_in_Ga);
+  EXPECT_EQ(result.state.teammate(12).q_Ga_Gb.coeffs(), pr.x_hat.teammate(12).q_Ga_Gb.coeffs());
   EXPECT_EQ(MaxAbs(result.covariance.block(b12.offset, b12.offset, 6, 6) -
                    pr.P.block(b12.offset, b12.offset, 6, 6)),
             0.0);
@@ -344,8 +344,8 @@ TEST(EsikfMutualUpdate, ConsideredBlocksEnterTheGainAndStayUncorrected) {
       EsikfUpdate().Run(pr.x_hat, pr.P, {&plane_model, &pr.terms}, &estimated, &considered);
   ASSERT_TRUE(iterated.status.ok());
   EXPECT_GT(iterated.iterations, 1);
-  EXPECT_EQ(iterated.state.teammate(12).p_Gj_in_Gi, pr.x_hat.teammate(12).p_Gj_in_Gi);
-  EXPECT_EQ(iterated.state.teammate(12).q_Gi_Gj.coeffs(), pr.x_hat.teammate(12).q_Gi_Gj.coeffs());
+  EXPECT_EQ(iterated.state.teammate(12).p_Gb_in_Ga, pr.x_hat.teammate(12).p_Gb_in_Ga);
+  EXPECT_EQ(iterated.state.teammate(12).q_Ga_Gb.coeffs(), pr.x_hat.teammate(12).q_Ga_Gb.coeffs());
   // The considered block mattered: leaving its covariance out (block 12
   // held exact, the former "frozen" form) gives another ego step.
   EXPECT_GT(dx.head<6>().norm(), 1e-3);

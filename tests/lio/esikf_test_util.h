@@ -44,8 +44,8 @@ class Sampler {
     x.ego.g_in_G = Eigen::Vector3d(0.1, -0.2, -9.8);
     for (int j = 0; j < num_teammates; ++j) {
       GlobalExtrinsic T;
-      T.q_Gi_Gj = Rotation();
-      T.p_Gj_in_Gi = Gaussian(3, 10.0);
+      T.q_Ga_Gb = Rotation();
+      T.p_Gb_in_Ga = Gaussian(3, 10.0);
       x.AddTeammate(2 + 5 * j, T);
     }
     return x;

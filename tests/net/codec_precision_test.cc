@@ -112,8 +112,8 @@ TEST(CodecPrecision, GlobalExtrinsicFieldsWithinTheDocumentedPrecision) {
     for (size_t i = 0; i < m.entries.size(); ++i) {
       EXPECT_EQ(d.entries[i].teammate_id, m.entries[i].teammate_id);
       EXPECT_EQ(d.entries[i].source, m.entries[i].source);
-      EXPECT_LT(d.entries[i].q_Gi_Gj.angularDistance(m.entries[i].q_Gi_Gj), kQuaternionAngle);
-      ExpectFloat32(m.entries[i].p_Gj_in_Gi, d.entries[i].p_Gj_in_Gi, "p_Gj_in_Gi");
+      EXPECT_LT(d.entries[i].q_Ga_Gb.angularDistance(m.entries[i].q_Ga_Gb), kQuaternionAngle);
+      ExpectFloat32(m.entries[i].p_Gb_in_Ga, d.entries[i].p_Gb_in_Ga, "p_Gb_in_Ga");
       ExpectCovariance<6>(m.entries[i].covariance, d.entries[i].covariance, "covariance");
     }
   }

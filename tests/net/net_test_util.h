@@ -125,8 +125,8 @@ inline GlobalExtrinsicMessage MakeRawGlobalExtrinsic(int sender, int num_entries
     GlobalExtrinsicEntry e;
     e.teammate_id = id;
     e.source = (i % 2 == 0) ? ExtrinsicSource::kTrajectoryMatch : ExtrinsicSource::kGraph;
-    e.q_Gi_Gj = v.Quaternion();
-    e.p_Gj_in_Gi = v.Vector32(100.0);
+    e.q_Ga_Gb = v.Quaternion();
+    e.p_Gb_in_Ga = v.Vector32(100.0);
     e.covariance = v.Covariance<6>(1e-4);
     m.entries.push_back(e);
     ++i;
@@ -232,8 +232,8 @@ inline void ExpectSameMessage(const SwarmMessage& expected, const SwarmMessage& 
     for (size_t i = 0; i < g->entries.size(); ++i) {
       EXPECT_EQ(g->entries[i].teammate_id, a.entries[i].teammate_id);
       EXPECT_EQ(g->entries[i].source, a.entries[i].source);
-      EXPECT_EQ(g->entries[i].q_Gi_Gj.coeffs(), a.entries[i].q_Gi_Gj.coeffs());
-      EXPECT_EQ(g->entries[i].p_Gj_in_Gi, a.entries[i].p_Gj_in_Gi);
+      EXPECT_EQ(g->entries[i].q_Ga_Gb.coeffs(), a.entries[i].q_Ga_Gb.coeffs());
+      EXPECT_EQ(g->entries[i].p_Gb_in_Ga, a.entries[i].p_Gb_in_Ga);
       EXPECT_EQ(g->entries[i].covariance, a.entries[i].covariance);
     }
   } else {

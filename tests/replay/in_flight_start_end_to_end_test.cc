@@ -184,7 +184,7 @@ class InFlightStartTest : public ::testing::Test {
         const auto t = std::find_if(s->teammates.begin(), s->teammates.end(),
                                     [&](const swarm::TeammateEstimate& r) { return r.drone_id == late; });
         if (t == s->teammates.end()) continue;
-        const Eigen::Isometry3d E = T_true.inverse() * t->T_Gi_Gj.T_Gi_Gj();
+        const Eigen::Isometry3d E = T_true.inverse() * t->T_Gi_Gj.T_Ga_Gb();
         f.end_error_m[i] = E.translation().norm();
         f.end_error_deg[i] = Eigen::AngleAxisd(E.linear()).angle() * 180.0 / M_PI;
         break;

@@ -79,8 +79,9 @@ ChainResult RunRestartChain(bool graph_through_derived, bool relayed_sends_deriv
   const Eigen::Isometry3d T_true = ToIsometry(run.simulator->T_W_G(observer)).inverse() * T_W_Gj_new;
   for (const TeammateEstimate& t : sink.outputs.back().teammates) {
     if (t.drone_id != teammate) continue;
-    r.error_m = (t.T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm();
-    r.error_deg = Eigen::AngleAxisd(t.T_Gi_Gj.R_Gi_Gj().transpose() * T_true.linear()).angle() * 180.0 / M_PI;
+    r.error_m = (t.T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm();
+    r.error_deg =
+        Eigen::AngleAxisd(t.T_Gi_Gj.R_Ga_Gb().transpose() * T_true.linear()).angle() * 180.0 / M_PI;
   }
   return r;
 }

@@ -211,10 +211,10 @@ TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) 
   ASSERT_EQ(last.teammates.size(), 1u);
   const Eigen::Isometry3d T_true =
       ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
-  const double p_err = (last.teammates[0].T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm();
-  const double r_err = Eigen::AngleAxisd(T_true.linear().transpose() *
-                                         last.teammates[0].T_Gi_Gj.R_Gi_Gj())
-                           .angle() * 180.0 / M_PI;
+  const double p_err = (last.teammates[0].T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm();
+  const double r_err =
+      Eigen::AngleAxisd(T_true.linear().transpose() * last.teammates[0].T_Gi_Gj.R_Ga_Gb()).angle() *
+      180.0 / M_PI;
   const Eigen::Vector3d sigma = last.teammates[0].extrinsic_covariance.diagonal().tail<3>().cwiseSqrt();
   std::printf("[ figures  ] identified at scan %d, removed at scan %d, %d active / %d passive "
               "fused, T_Gi_Gj error %.4f m %.3f deg (1-sigma %.4f %.4f %.4f m)\n",
@@ -285,7 +285,7 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
   ASSERT_EQ(last.teammates.size(), 1u);
   const Eigen::Isometry3d T_true =
       ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
-  EXPECT_LT((last.teammates[0].T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm(), 0.03);
+  EXPECT_LT((last.teammates[0].T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm(), 0.03);
   EXPECT_EQ(run.estimator().counters().extrinsics_stale, 0);
 }
 
@@ -369,9 +369,9 @@ TEST(DroneEstimator, AddsATeammateThroughAnIdentifiedTeammate) {
     SCOPED_TRACE(t.drone_id);
     const Eigen::Isometry3d T_true = ToIsometry(simulator.T_W_G(observer)).inverse() *
                                      ToIsometry(simulator.T_W_G(t.drone_id));
-    EXPECT_LT((t.T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm(), 0.03);
+    EXPECT_LT((t.T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm(), 0.03);
     const double angle =
-        Eigen::AngleAxisd(t.T_Gi_Gj.R_Gi_Gj().transpose() * T_true.linear()).angle();
+        Eigen::AngleAxisd(t.T_Gi_Gj.R_Ga_Gb().transpose() * T_true.linear()).angle();
     EXPECT_LT(angle, 0.5 * M_PI / 180.0);
     // At least the relayed entry's own uncertainty (1 cm): composing cannot
     // make it more certain than its parts.

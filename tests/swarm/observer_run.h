@@ -227,8 +227,8 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
           net::GlobalExtrinsicEntry e;
           e.teammate_id = id;
           e.source = source;
-          e.q_Gi_Gj = Eigen::Quaterniond(T.linear()).normalized();
-          e.p_Gj_in_Gi = T.translation();
+          e.q_Ga_Gb = Eigen::Quaterniond(T.linear()).normalized();
+          e.p_Gb_in_Ga = T.translation();
           e.covariance.diagonal() << 1.2e-5, 1.2e-5, 1.2e-5, 1e-4, 1e-4, 1e-4;
           return e;
         };
@@ -254,8 +254,8 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
         g.stamp_ns = m.stamp_ns;
         net::GlobalExtrinsicEntry e;
         e.teammate_id = observer_;
-        e.q_Gi_Gj = Eigen::Quaterniond(T_Gj_Gi.linear()).normalized();
-        e.p_Gj_in_Gi = T_Gj_Gi.translation();
+        e.q_Ga_Gb = Eigen::Quaterniond(T_Gj_Gi.linear()).normalized();
+        e.p_Gb_in_Ga = T_Gj_Gi.translation();
         e.covariance.diagonal() << 1.2e-5, 1.2e-5, 1.2e-5, 1e-4, 1e-4, 1e-4;
         g.entries.push_back(e);
         if (relayed_id >= 0 && !relayed_sends_derived) {
@@ -263,8 +263,8 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
           const Eigen::Isometry3d T_Gj_Gk = T_Gj_W_ * ToIsometry(sim_.T_W_G(relayed_id));
           net::GlobalExtrinsicEntry ek = e;
           ek.teammate_id = relayed_id;
-          ek.q_Gi_Gj = Eigen::Quaterniond(T_Gj_Gk.linear()).normalized();
-          ek.p_Gj_in_Gi = T_Gj_Gk.translation();
+          ek.q_Ga_Gb = Eigen::Quaterniond(T_Gj_Gk.linear()).normalized();
+          ek.p_Gb_in_Ga = T_Gj_Gk.translation();
           g.entries.push_back(ek);
         }
         // Its gravity in G_j (the simulator's W has z up).

@@ -19,8 +19,8 @@ GlobalExtrinsic RandomExtrinsic(std::mt19937* rng, double angle) {
   std::normal_distribution<double> n;
   const Eigen::Vector3d axis = Eigen::Vector3d(n(*rng), n(*rng), n(*rng)).normalized();
   GlobalExtrinsic T;
-  T.q_Gi_Gj = so3::ExpQuaternion(axis * angle);
-  T.p_Gj_in_Gi = 5.0 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+  T.q_Ga_Gb = so3::ExpQuaternion(axis * angle);
+  T.p_Gb_in_Ga = 5.0 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
   return T;
 }
 
@@ -56,7 +56,8 @@ TEST(ComposeExtrinsic, ComposesAndItsJacobiansMatchNumericDifferentiation) {
       ComposeExtrinsic(T_ij, T_jk, &T_ik, &J_ij, &J_jk);
       // The composition itself: a point of G_k mapped to G_i both ways.
       const Eigen::Vector3d x_in_Gk(0.3, -1.2, 2.0);
-      EXPECT_LT((T_ik.T_Gi_Gj() * x_in_Gk - T_ij.T_Gi_Gj() * (T_jk.T_Gi_Gj() * x_in_Gk)).norm(), 1e-12);
+      EXPECT_LT((T_ik.T_Ga_Gb() * x_in_Gk - T_ij.T_Ga_Gb() * (T_jk.T_Ga_Gb() * x_in_Gk)).norm(),
+                1e-12);
       EXPECT_LT((J_ij - Numeric(T_ij, T_jk, true)).norm(), 1e-6);
       EXPECT_LT((J_jk - Numeric(T_ij, T_jk, false)).norm(), 1e-6);
     }

@@ -31,8 +31,8 @@ class StateSampler : public RandomSampler {
   // T_Gi_Gj rotated by `angle` (uniform when < 0), origin within ~10 m.
   GlobalExtrinsic Extrinsic(double angle) {
     GlobalExtrinsic T;
-    T.q_Gi_Gj = Rotation(angle);
-    T.p_Gj_in_Gi = Gaussian3(10.0);
+    T.q_Ga_Gb = Rotation(angle);
+    T.p_Gb_in_Ga = Gaussian3(10.0);
     return T;
   }
 

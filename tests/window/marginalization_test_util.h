@@ -77,8 +77,8 @@ class Sampler {
   }
   GlobalExtrinsic Extrinsic() {
     GlobalExtrinsic T;
-    T.q_Gi_Gj = Rotation();
-    T.p_Gj_in_Gi = Gaussian3(10.0);
+    T.q_Ga_Gb = Rotation();
+    T.p_Gb_in_Ga = Gaussian3(10.0);
     return T;
   }
   EgoState Perturb(const EgoState& ego, double scale) {
@@ -291,12 +291,12 @@ class Window {
   void AddActive(
       Sampler* s, const EgoState& truth, const GlobalExtrinsic& T_truth, int k, Loss kind) {
     const Eigen::Vector3d p_bj_in_Gj = s->Gaussian3(8.0);
-    const Eigen::Vector3d z = truth.R_G_b().transpose() * (T_truth.R_Gi_Gj() * p_bj_in_Gj +
-                                                           T_truth.p_Gj_in_Gi - truth.p_b_in_G) +
+    const Eigen::Vector3d z = truth.R_G_b().transpose() * (T_truth.R_Ga_Gb() * p_bj_in_Gj +
+                                                           T_truth.p_Gb_in_Ga - truth.p_b_in_G) +
                               s->Gaussian3(0.05);
     auto factor = std::make_unique<ActiveObservationFactor>(z, p_bj_in_Gj, s->Spd(3, 1e-3, 1e-2),
                                                             s->Spd(3, 1e-3, 1e-2), lin_[k].R_G_b(),
-                                                            T_lin_.R_Gi_Gj());
+                                                            T_lin_.R_Ga_Gb());
     const double squared_norm = factor->Residual(lin_[k], T_lin_).squaredNorm();
     std::unique_ptr<ceres::LossFunction> loss;
     if (kind == Loss::kHuber) {

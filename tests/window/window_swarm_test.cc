@@ -94,10 +94,10 @@ void ExtrinsicDifference(const DroneRun& a, const DroneRun& b, double* max_m, do
     for (const swarm::TeammateEstimate& ta : a.scans[k].teammates) {
       for (const swarm::TeammateEstimate& tb : b.scans[k].teammates) {
         if (ta.drone_id != tb.drone_id) continue;
-        *max_m = std::max(*max_m, (ta.T_Gi_Gj.p_Gj_in_Gi - tb.T_Gi_Gj.p_Gj_in_Gi).norm());
+        *max_m = std::max(*max_m, (ta.T_Gi_Gj.p_Gb_in_Ga - tb.T_Gi_Gj.p_Gb_in_Ga).norm());
         *max_deg = std::max(
             *max_deg,
-            so3::Log(ta.T_Gi_Gj.q_Gi_Gj.conjugate() * tb.T_Gi_Gj.q_Gi_Gj).norm() * 180.0 / M_PI);
+            so3::Log(ta.T_Gi_Gj.q_Ga_Gb.conjugate() * tb.T_Gi_Gj.q_Ga_Gb).norm() * 180.0 / M_PI);
       }
     }
   }

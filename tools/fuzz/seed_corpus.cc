@@ -74,8 +74,8 @@ net::GlobalExtrinsicMessage GlobalExtrinsic(int sender, int num_entries) {
     net::GlobalExtrinsicEntry e;
     e.teammate_id = id;
     e.source = id % 2 == 0 ? net::ExtrinsicSource::kTrajectoryMatch : net::ExtrinsicSource::kGraph;
-    e.q_Gi_Gj = Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * (id + 1), Eigen::Vector3d::UnitZ()));
-    e.p_Gj_in_Gi = {10.0 * id, -2.5, 0.75};
+    e.q_Ga_Gb = Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * (id + 1), Eigen::Vector3d::UnitZ()));
+    e.p_Gb_in_Ga = {10.0 * id, -2.5, 0.75};
     e.covariance = 1e-4 * Eigen::Matrix<double, 6, 6>::Identity();
     e.covariance(0, 3) = e.covariance(3, 0) = 2e-5;  // rotation-translation correlation
     m.entries.push_back(e);

@@ -81,8 +81,8 @@ void LiveOutputs::OnScan(const swarm::DroneOutput& o, const live::ScanLatency& l
           identifications_path_);
   }
   for (const swarm::TeammateEstimate& e : o.teammates) {
-    const Eigen::Quaterniond& q = e.T_Gi_Gj.q_Gi_Gj;
-    const Eigen::Vector3d& p = e.T_Gi_Gj.p_Gj_in_Gi;
+    const Eigen::Quaterniond& q = e.T_Gi_Gj.q_Ga_Gb;
+    const Eigen::Vector3d& p = e.T_Gi_Gj.p_Gb_in_Ga;
     const auto& C = e.extrinsic_covariance;
     Check(std::fprintf(extrinsics_,
                        "%.9f,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d\n",

@@ -84,8 +84,8 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
     for (const swarm::DroneOutput& s : scans) {
       const double t = ToSeconds(s.ego.stamp_ns);
       for (const swarm::TeammateEstimate& r : s.teammates) {
-        const Eigen::Quaterniond& q = r.T_Gi_Gj.q_Gi_Gj;
-        const Eigen::Vector3d& p = r.T_Gi_Gj.p_Gj_in_Gi;
+        const Eigen::Quaterniond& q = r.T_Gi_Gj.q_Ga_Gb;
+        const Eigen::Vector3d& p = r.T_Gi_Gj.p_Gb_in_Ga;
         ext << std::setprecision(9) << t << "," << run.drone(r.drone_id).input().name << ","
             << q.x() << "," << q.y() << "," << q.z() << "," << q.w() << "," << p.x() << ","
             << p.y() << "," << p.z();
@@ -104,7 +104,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
         // Errors against the truth (simulated runs: the manifest's G frames).
         const Eigen::Isometry3d T_true = d.input().T_W_G().inverse() * run.drone(r.drone_id).input().T_W_G();
         const double e_m = (p - T_true.translation()).norm();
-        const double e_deg = RotationDeg(T_true.linear().transpose() * r.T_Gi_Gj.R_Gi_Gj());
+        const double e_deg = RotationDeg(T_true.linear().transpose() * r.T_Gi_Gj.R_Ga_Gb());
         m.extrinsic_end_m = e_m;
         m.extrinsic_end_deg = e_deg;
         m.extrinsic_max_m = std::max(m.extrinsic_max_m, e_m);
@@ -147,9 +147,9 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
           m.identification_s = ToSeconds(e.stamp_ns) - t0;
           const Eigen::Isometry3d T_true =
               d.input().T_W_G().inverse() * run.drone(j).input().T_W_G();
-          m.initial_error_m = (e.initial_T_Gi_Gj.p_Gj_in_Gi - T_true.translation()).norm();
+          m.initial_error_m = (e.initial_T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm();
           m.initial_error_deg =
-              RotationDeg(T_true.linear().transpose() * e.initial_T_Gi_Gj.R_Gi_Gj());
+              RotationDeg(T_true.linear().transpose() * e.initial_T_Gi_Gj.R_Ga_Gb());
           if (has_truth[i] && has_truth[j]) {
             // Ground-truth stamps are in each drone's clock, like its bag:
             // j's excitation start moved to i's clock.
@@ -189,7 +189,7 @@ Status WriteSwarmReport(const replay::SwarmReplay& run, const std::string& outpu
   if (save_maps && n > 0 && !run.drone(0).scans().empty()) {
     std::vector<Eigen::Vector3d> merged = run.drone(0).estimator().MapPoints();
     for (const swarm::TeammateEstimate& r : run.drone(0).scans().back().teammates) {
-      const Eigen::Isometry3d T = r.T_Gi_Gj.T_Gi_Gj();
+      const Eigen::Isometry3d T = r.T_Gi_Gj.T_Ga_Gb();
       for (const Eigen::Vector3d& p : run.drone(r.drone_id).estimator().MapPoints()) {
         merged.push_back(T * p);
       }

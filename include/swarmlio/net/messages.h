@@ -124,13 +124,17 @@ enum class ExtrinsicSource : uint8_t {
   kGraph = 2,            // derived through the extrinsic graph
 };
 
-/// The sender i's estimate of T_Gi_Gj for one teammate j.
+/// The sender's estimate of T_Ga_Gb for one teammate: a is the sender
+/// (GlobalExtrinsicMessage::sender_id), b is teammate_id. Neutral names
+/// because the frames are the sender's: a receiver names them once, where it
+/// stores the entry (src/swarm/message_inbox.cc: T_Gj_Gk, or T_Gj_Gi when b
+/// is the receiver itself).
 struct GlobalExtrinsicEntry {
-  int teammate_id = 0;  // j
+  int teammate_id = 0;  // b
   ExtrinsicSource source = ExtrinsicSource::kTrajectoryMatch;
-  Eigen::Quaterniond q_Gi_Gj = Eigen::Quaterniond::Identity();  // unit
-  Eigen::Vector3d p_Gj_in_Gi = Eigen::Vector3d::Zero();         // [m]
-  /// Covariance of [dtheta (rad); dp (m)], R_Gi_Gj = R^ Exp(dtheta) (the
+  Eigen::Quaterniond q_Ga_Gb = Eigen::Quaterniond::Identity();  // unit
+  Eigen::Vector3d p_Gb_in_Ga = Eigen::Vector3d::Zero();         // [m]
+  /// Covariance of [dtheta (rad); dp (m)], R_Ga_Gb = R^ Exp(dtheta) (the
   /// teammate block order of ErrorStateLayout). Full 6x6: rotation and
   /// translation of a trajectory match are strongly correlated.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();

@@ -122,7 +122,7 @@ constexpr int64_t PastObservationAgeCode(int64_t age_ns) {
 }
 // GlobalExtrinsic: stamp i64 | g_in_Gi f32 x3 | cov_g_in_Gi cov(3) | count u8 |
 //   count x { teammate id u8 | bits u8 (0-1 q largest index, 2 source: 0 trajectory
-//   match, 1 graph) | q_Gi_Gj 3 x i16 | p_Gj_in_Gi f32 x3 | covariance cov(6) }
+//   match, 1 graph) | q_Ga_Gb 3 x i16 | p_Gb_in_Ga f32 x3 | covariance cov(6) }
 inline constexpr size_t kGlobalExtrinsicFixedBytes = 8 + 12 + CovarianceBytes(3) + 1;
 inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 6 + 12 + CovarianceBytes(6);
 // TimeSync: target id u8 | kind u8 (0 request, 1 response) | t1 t2 t3 i64

@@ -8,7 +8,7 @@
 // Ceres parameter blocks (factors/ego_state_manifold.h,
 // factors/global_extrinsic_manifold.h) use the ambient layouts
 //   ego      (19): [q_G_b (x y z w) | p_b_in_G | v_b_in_G | b_g | b_a | g_in_G]
-//   teammate  (7): [q_Gi_Gj (x y z w) | p_Gj_in_Gi]
+//   teammate  (7): [q_Ga_Gb (x y z w) | p_Gb_in_Ga] = T_Gi_Gj of teammate j
 // whose tangent spaces are exactly the corresponding error-state segments.
 #pragma once
 
@@ -44,17 +44,20 @@ struct EgoState {
   Eigen::Matrix<double, kTangentSize, 1> BoxMinus(const EgoState& other) const;
 };
 
-/// Global extrinsic T_Gi_Gj between this drone's global frame G_i and
-/// teammate j's global frame G_j: p_in_Gi = R_Gi_Gj p_in_Gj + p_Gj_in_Gi.
+/// Global extrinsic T_Ga_Gb between two drones' global frames G_a and G_b:
+/// p_in_Ga = R_Ga_Gb p_in_Gb + p_Gb_in_Ga. The names are neutral because the
+/// same type holds several pairs: in a SwarmState block a is the owning drone
+/// i and b its teammate j (T_Gi_Gj); a composed, inverted or received value
+/// says which in its variable name (T_jk, T_Gj_Gk: a = j, b = k).
 struct GlobalExtrinsic {
   static constexpr int kAmbientSize = 7;
   static constexpr int kTangentSize = ErrorStateLayout::kTeammateDim;
 
-  Eigen::Quaterniond q_Gi_Gj = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d p_Gj_in_Gi = Eigen::Vector3d::Zero();  // [m]
+  Eigen::Quaterniond q_Ga_Gb = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d p_Gb_in_Ga = Eigen::Vector3d::Zero();  // [m]
 
-  Eigen::Matrix3d R_Gi_Gj() const { return q_Gi_Gj.toRotationMatrix(); }
-  Eigen::Isometry3d T_Gi_Gj() const;
+  Eigen::Matrix3d R_Ga_Gb() const { return q_Ga_Gb.toRotationMatrix(); }
+  Eigen::Isometry3d T_Ga_Gb() const;
 
   void ToParameters(double* x) const;
   static GlobalExtrinsic FromParameters(const double* x);

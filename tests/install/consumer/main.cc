@@ -20,12 +20,12 @@ int main() {
   // The Jacobian checker accepts the factor and rejects a flipped rotation sign.
   x.ego.q_G_b = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
   x.ego.p_b_in_G = Eigen::Vector3d(1.0, -2.0, 0.5);
-  x.teammate(2).q_Gi_Gj = Eigen::Quaterniond(Eigen::AngleAxisd(-1.1, Eigen::Vector3d::UnitZ()));
-  x.teammate(2).p_Gj_in_Gi = Eigen::Vector3d(4.0, 1.0, -0.3);
+  x.teammate(2).q_Ga_Gb = Eigen::Quaterniond(Eigen::AngleAxisd(-1.1, Eigen::Vector3d::UnitZ()));
+  x.teammate(2).p_Gb_in_Ga = Eigen::Vector3d(4.0, 1.0, -0.3);
   const swarmlio::ActiveObservationFactor factor(
       Eigen::Vector3d(3.0, 0.5, 0.2), Eigen::Vector3d(-1.0, 2.0, 0.4),
       0.01 * Eigen::Matrix3d::Identity(), 0.02 * Eigen::Matrix3d::Identity(), x.ego.R_G_b(),
-      x.teammate(2).R_Gi_Gj());
+      x.teammate(2).R_Ga_Gb());
   std::array<double, 19> ego;
   std::array<double, 7> extrinsic;
   x.ego.ToParameters(ego.data());
