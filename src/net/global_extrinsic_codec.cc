@@ -23,7 +23,8 @@ Status DecodeEntry(PacketReader* r, GlobalExtrinsicEntry* e) {
   e->teammate_id = id;
   e->source =
       (bits & kGraphSourceFlag) != 0 ? ExtrinsicSource::kGraph : ExtrinsicSource::kTrajectoryMatch;
-  SWARMLIO_RETURN_IF_ERROR(ReadQuaternion("q_Ga_Gb", bits & kQuaternionLargestMask, r, &e->q_Ga_Gb));
+  SWARMLIO_RETURN_IF_ERROR(
+      ReadQuaternion("q_Ga_Gb", bits & kQuaternionLargestMask, r, &e->q_Ga_Gb));
   SWARMLIO_RETURN_IF_ERROR(ReadVectorF32("p_Gb_in_Ga", r, &e->p_Gb_in_Ga));
   return ReadCovariance<6>("covariance", r, &e->covariance);
 }

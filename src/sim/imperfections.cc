@@ -11,7 +11,6 @@
 namespace swarmlio::sim {
 namespace {
 
-
 // "" when `range` is [min, max] with min <= max, else "key: reason".
 std::string CheckInterval(const char* key, const std::vector<double>& range) {
   if (range.size() != 2) return std::string(key) + ": expected [min, max]";
@@ -74,7 +73,7 @@ ImuImperfectionOptions RealisticImuImperfections() {
   o.accel_scale_factor_sigma = 0.005;
   o.gyro_misalignment_sigma_rad = 0.005;  // cross-axis sensitivity +-1 % as 2 sigma
   o.accel_misalignment_sigma_rad = 0.005;
-  o.gyro_lsb_rad_s = 2000.0 / 32768.0 * kRadiansPerDegree;   // +-2000 deg/s over 16 bit
+  o.gyro_lsb_rad_s = 2000.0 / 32768.0 * kRadiansPerDegree;  // +-2000 deg/s over 16 bit
   o.accel_lsb_m_s2 = 24.0 * 9.80665 / 32768.0;  // BMI088 +-24 g over 16 bit
   o.sample_dropout_probability = 1e-3;
   o.timestamp_jitter_s = 1e-4;

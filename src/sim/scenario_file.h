@@ -66,7 +66,6 @@ namespace swarmlio::sim::scenario_file {
 
 using config::FieldSpec;
 
-
 struct ArenaSpec {
   Eigen::Vector3d size_m = Eigen::Vector3d::Zero();  // inner size; 0 = no arena
   Eigen::Vector3d floor_center_m = Eigen::Vector3d::Zero();
@@ -137,10 +136,11 @@ struct PrimitiveSpec {
   }
   Primitive Make() const {
     const Material mat{material, reflectivity_percent};
-    const Eigen::Matrix3d R = (Eigen::AngleAxisd(rpy_deg.z() * kRadiansPerDegree, Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(rpy_deg.y() * kRadiansPerDegree, Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(rpy_deg.x() * kRadiansPerDegree, Eigen::Vector3d::UnitX()))
-                                  .toRotationMatrix();
+    const Eigen::Matrix3d R =
+        (Eigen::AngleAxisd(rpy_deg.z() * kRadiansPerDegree, Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(rpy_deg.y() * kRadiansPerDegree, Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(rpy_deg.x() * kRadiansPerDegree, Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
     switch (type) {
       case PrimitiveKind::kBox:
         return Primitive::AxisAlignedBox(min_m, max_m, mat);
