@@ -20,6 +20,7 @@ struct DroneEntry {
   std::string bag;
   std::string ground_truth;
   eval::GroundTruthFrame ground_truth_frame = eval::GroundTruthFrame::kAuto;
+  std::string teammate_returns;
   std::string sensor_preset;
   LidarOptions lidar;
   ImuOptions imu;
@@ -45,6 +46,9 @@ struct DroneEntry {
       FieldSpec::Doc("frame of the ground truth: G (the estimator's: NEES is reported), other "
                      "(mocap/simulator world: aligned, no NEES) or auto (G when it starts at "
                      "the estimate's first pose)"));
+    v("teammate_returns", teammate_returns,
+      FieldSpec::Doc("simulator truth: CSV of the returns each scan had on each teammate, "
+                     "relative to the manifest's folder (optional; evaluation only)"));
     v("sensor_preset", sensor_preset,
       FieldSpec::Doc("sensor preset (lidar: and imu: sections), relative to the manifest"));
     v("lidar", lidar);
@@ -154,6 +158,7 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     d.bag_path = Resolve(folder, e.bag);
     d.ground_truth_path = Resolve(folder, e.ground_truth);
     d.ground_truth_frame = e.ground_truth_frame;
+    if (!e.teammate_returns.empty()) d.teammate_returns_path = Resolve(folder, e.teammate_returns);
     d.bag = e.bag_topics;
     d.true_clock = e.true_clock;
     d.start_offset_s = e.start_offset_s;

@@ -125,6 +125,8 @@ std::string ReplayManifestYaml(const Scenario& s, const Simulator& sim) {
     os << "    p_G_in_W_m: " << Vec(T.p_b_in_W) << "\n";
     os << "    q_W_G_xyzw: " << Quat(Eigen::Quaterniond(T.R_W_b)) << "\n";
     os << "    ground_truth: " << d.name << "_gt_tum.txt\n";
+    os << "    # returns of each scan on each teammate's body (truth, for evaluation)\n";
+    os << "    teammate_returns: " << d.name << "_teammate_returns.csv\n";
     os << "    # the drone's clock (truth, for packet delivery in the replay only)\n";
     os << "    true_clock: {offset_s: " << d.clock_offset_s << ", drift_ppm: " << d.clock_drift_ppm
        << ", origin_s: " << sim.config().stamp_origin_s << "}\n";
@@ -174,9 +176,38 @@ Status DroneOutputWriter::OnGroundTruth(const PoseStamped& pose) {
   return Status::Ok();
 }
 
+Status DroneOutputWriter::WriteTeammateReturnsTo(const std::string& csv_path,
+                                                 std::vector<std::string> drone_names) {
+  returns_path_ = csv_path;
+  drone_names_ = std::move(drone_names);
+  returns_.open(csv_path, std::ios::out | std::ios::trunc);
+  if (!returns_) return Status::IoError(csv_path + ": cannot open for writing");
+  returns_ << "scan_stamp_s,scan_end_s,teammate,returns\n";
+  return Status::Ok();
+}
+
+Status DroneOutputWriter::OnTeammateReturns(int64_t scan_stamp_ns, int64_t scan_end_ns,
+                                            const std::vector<int>& returns_per_drone) {
+  if (!returns_.is_open()) return Status::Ok();
+  for (size_t k = 0; k < returns_per_drone.size() && k < drone_names_.size(); ++k) {
+    if (returns_per_drone[k] <= 0) continue;
+    char line[160];
+    std::snprintf(line, sizeof(line), "%" PRId64 ".%09" PRId64 ",%" PRId64 ".%09" PRId64 ",",
+                  scan_stamp_ns / 1000000000, scan_stamp_ns % 1000000000,
+                  scan_end_ns / 1000000000, scan_end_ns % 1000000000);
+    returns_ << line << drone_names_[k] << "," << returns_per_drone[k] << "\n";
+  }
+  if (!returns_) return Status::IoError(returns_path_ + ": write failed");
+  return Status::Ok();
+}
+
 Status DroneOutputWriter::Close() {
   tum_.close();
   if (tum_.fail()) return Status::IoError(tum_path_ + ": close failed");
+  if (returns_.is_open()) {
+    returns_.close();
+    if (returns_.fail()) return Status::IoError(returns_path_ + ": close failed");
+  }
   return bag_->Close();
 }
 

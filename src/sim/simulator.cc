@@ -1,5 +1,6 @@
 #include "swarmlio/sim/simulator.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <thread>
@@ -134,9 +135,12 @@ Status Simulator::RunDrone(int drone, DroneSink* sink, DroneStats* stats) const 
     scan.livox_timebase_ns = livox ? static_cast<uint64_t>(scan.stamp_ns) : 0;
     scan.livox_lidar_id = 0;
     scan.points.resize(sim_scan.points.size());
+    std::vector<int> returns_per_drone(drones_.size(), 0);
     bool sees_teammate = false;
+    double last_point_t_s = sim_scan.start_time_s;
     for (size_t i = 0; i < sim_scan.points.size(); ++i) {
       const SimulatedPoint& p = sim_scan.points[i];
+      last_point_t_s = std::max(last_point_t_s, p.t_s);
       LidarPoint& out = scan.points[i];
       out.x = static_cast<float>(p.p_in_lidar.x());
       out.y = static_cast<float>(p.p_in_lidar.y());
@@ -148,6 +152,7 @@ Status Simulator::RunDrone(int drone, DroneSink* sink, DroneStats* stats) const 
       out.line = p.line;
       if (p.object >= 0 && p.object < static_cast<int>(drones_.size())) {
         ++stats->points_on_teammates;
+        ++returns_per_drone[p.object];
         sees_teammate = true;
       }
       if (p.reflectivity > 150.0) ++stats->tape_points;
@@ -156,6 +161,10 @@ Status Simulator::RunDrone(int drone, DroneSink* sink, DroneStats* stats) const 
     stats->scans_seeing_teammates += sees_teammate;
     ++stats->scans;
     SWARMLIO_RETURN_IF_ERROR(sink->OnScan(scan, StampNs(drone, frame_end)));
+    if (sees_teammate) {
+      SWARMLIO_RETURN_IF_ERROR(sink->OnTeammateReturns(
+          scan.stamp_ns, StampNs(drone, last_point_t_s), returns_per_drone));
+    }
   }
   return Status::Ok();
 }

@@ -15,6 +15,14 @@
 
 namespace swarmlio::tools {
 
+/// A teammate is in view in a scan when its body returned at least this many
+/// points (the definition of "in view").
+constexpr int kInViewReturns = 10;
+/// Initial T_Gi_Gj errors beyond which an identification counts as wrong
+/// (a right one starts within a few cm and a degree; docs/replay.md).
+constexpr double kWrongIdentificationM = 0.5;
+constexpr double kWrongIdentificationDeg = 5.0;
+
 /// One observer-teammate pair.
 struct PairMetrics {
   std::string observer;
@@ -32,6 +40,16 @@ struct PairMetrics {
   int relative_samples = 0;
   int active_fused = 0;
   int passive_fused = 0;
+  /// Scans after the identification in which j's body returned at least
+  /// kInViewReturns points (simulator truth, manifest `teammate_returns`;
+  /// -1 when the manifest has none), and how many of them fused an active
+  /// observation of j.
+  int scans_in_view = -1;
+  int fused_in_view = 0;
+  /// The identification's first T_Gi_Gj is off the truth by more than
+  /// kWrongIdentificationM or kWrongIdentificationDeg: j was matched to the
+  /// wrong track (another drone or a decoy).
+  bool wrong_identification = false;
   /// The observer's estimate of the teammate's clock offset at its last scan
   /// minus the truth (TrueClock of the manifest) [ms]; NaN when not estimated.
   double clock_offset_error_ms = std::nan("");

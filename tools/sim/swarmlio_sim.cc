@@ -96,11 +96,17 @@ int Main() {
   const std::filesystem::path dir(FLAGS_output_dir);
   std::vector<std::unique_ptr<DroneOutputWriter>> writers;
   std::vector<DroneSink*> sinks;
+  std::vector<std::string> drone_names;
+  for (const DroneConfig& d : scenario.drones) drone_names.push_back(d.name);
   for (const DroneConfig& d : scenario.drones) {
     std::unique_ptr<DroneOutputWriter> w;
     status = DroneOutputWriter::Open((dir / (d.name + ".bag")).string(),
                                      (dir / (d.name + "_gt_tum.txt")).string(),
                                      BagOptionsFor(scenario.bag, d.lidar.sensor), &w);
+    if (status.ok()) {
+      status = w->WriteTeammateReturnsTo((dir / (d.name + "_teammate_returns.csv")).string(),
+                                         drone_names);
+    }
     if (!status.ok()) {
       std::fprintf(stderr, "error: %s\n", status.message().c_str());
       return 1;

@@ -68,6 +68,7 @@ struct DroneInput {
   std::string bag_path;           // resolved (relative to the manifest folder)
   std::string ground_truth_path;  // resolved TUM file, "" = none
   eval::GroundTruthFrame ground_truth_frame = eval::GroundTruthFrame::kAuto;
+  std::string teammate_returns_path;  // resolved simulator truth CSV, "" = none
   LidarOptions lidar;
   ImuOptions imu;
   io::BagReaderOptions bag;

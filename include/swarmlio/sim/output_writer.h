@@ -7,6 +7,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "swarmlio/io/bag_writer.h"
 #include "swarmlio/sensors/lidar_options.h"
@@ -42,6 +43,12 @@ class DroneOutputWriter : public DroneSink {
   Status OnImu(const ImuSample& imu) override;
   Status OnScan(const LidarScan& scan, int64_t record_time_ns) override;
   Status OnGroundTruth(const PoseStamped& pose) override;
+  /// Also writes the teammate-returns truth to `csv_path` (docs/simulator.md
+  /// "Outputs"): `scan_stamp_s,scan_end_s,teammate,returns`, one row per
+  /// teammate a scan hit; `drone_names[k]` names drone k.
+  Status WriteTeammateReturnsTo(const std::string& csv_path, std::vector<std::string> drone_names);
+  Status OnTeammateReturns(int64_t scan_stamp_ns, int64_t scan_end_ns,
+                           const std::vector<int>& returns_per_drone) override;
   Status Close();
 
  private:
@@ -49,6 +56,9 @@ class DroneOutputWriter : public DroneSink {
   std::unique_ptr<io::BagWriter> bag_;
   std::ofstream tum_;
   std::string tum_path_;
+  std::ofstream returns_;
+  std::string returns_path_;
+  std::vector<std::string> drone_names_;
 };
 
 }  // namespace swarmlio::sim

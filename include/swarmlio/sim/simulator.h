@@ -68,6 +68,14 @@ class DroneSink {
   virtual Status OnScan(const LidarScan& scan, int64_t record_time_ns) = 0;
   /// Ground truth T_Gi_b in the drone's global frame, stamped in its clock.
   virtual Status OnGroundTruth(const PoseStamped& pose) = 0;
+  /// Truth for evaluation, after OnScan of a scan that sees a teammate: how
+  /// many of its returns hit each drone's body (`returns_per_drone[k]`: drone
+  /// k, 0 for the own entry). The scan's first point is stamped
+  /// `scan_stamp_ns`, its last `scan_end_ns` (drone clock). Default: ignored.
+  virtual Status OnTeammateReturns(int64_t /*scan_stamp_ns*/, int64_t /*scan_end_ns*/,
+                                   const std::vector<int>& /*returns_per_drone*/) {
+    return Status::Ok();
+  }
 };
 
 struct DroneStats {
