@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Identification beyond the tuning seed (docs/results.md "Identification over
+# Identification beyond the tuning seed (docs/notes/results_history.md "Identification over
 # seeds"): simulates indoor_3uav and decoys with other seeds, plus indoor_3uav
 # in a changed arena (12 x 9 m instead of 10 x 8 m, clutter as before), replays
 # each in swarm mode, and tabulates per run: pairs identified, identified within

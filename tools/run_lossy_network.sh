@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The lossy-network acceptance run (docs/results.md "Lossy network"): replays
+# The lossy-network acceptance run (docs/notes/results_history.md "Lossy network"): replays
 # scenarios already simulated by tools/run_scenarios.sh (their file seed, in
 # results/scenarios/<name>/seed<S>/) through a network
 # with 20 % loss and 100 ms latency (10 ms jitter) for network seeds 1-3 and
