@@ -156,12 +156,17 @@ Status EvaluateConsistency(const CovariantTrajectory& estimate,
   if (estimate.position_covariances.size() != estimate.poses.size()) {
     return Status::InvalidArgument("consistency: one position covariance per pose expected");
   }
+  const bool map_covariances = !estimate.map_position_covariances.empty();
+  if (map_covariances && estimate.map_position_covariances.size() != estimate.poses.size()) {
+    return Status::InvalidArgument("consistency: one map position covariance per pose expected");
+  }
   const std::vector<PoseStamped> poses = ToPoses(estimate.poses);
   const std::vector<PoseStamped> gt = ToPoses(reference);
   ConsistencyStats s;
   double sum_sq = 0.0, sum_nees = 0.0, sum_rot_sq = 0.0;
   const int64_t max_gap_ns = static_cast<int64_t>(std::llround(max_gt_gap_s * 1e9));
-  // Kept for the gauge-aligned NEES: position pairs and covariance factors.
+  // Kept for the gauge-aligned NEES: position pairs and the factors of the
+  // covariances relative to the estimator's own map.
   std::vector<Eigen::Vector3d> truth_positions, estimated_positions;
   std::vector<Eigen::LDLT<Eigen::Matrix3d>> factors;
   for (size_t i = 0; i < poses.size(); ++i) {
@@ -172,6 +177,9 @@ Status EvaluateConsistency(const CovariantTrajectory& estimate,
     const Eigen::Matrix3d& P_pp = estimate.position_covariances[i];
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(P_pp);
     if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) continue;
+    const Eigen::LDLT<Eigen::Matrix3d> map_ldlt =
+        map_covariances ? Eigen::LDLT<Eigen::Matrix3d>(estimate.map_position_covariances[i]) : ldlt;
+    if (map_ldlt.info() != Eigen::Success || !map_ldlt.isPositive()) continue;
     const double nees = e.dot(ldlt.solve(e));
     const double rot_deg = so3::Log(truth.q_G_b.conjugate() * r.q_G_b).norm() * 180.0 / M_PI;
     ++s.num_poses;
@@ -181,7 +189,7 @@ Status EvaluateConsistency(const CovariantTrajectory& estimate,
     s.position_max_m = std::max(s.position_max_m, e.norm());
     truth_positions.push_back(truth.p_b_in_G);
     estimated_positions.push_back(r.p_b_in_G);
-    factors.push_back(ldlt);
+    factors.push_back(map_ldlt);
   }
   if (s.num_poses == 0) {
     return Status::FailedPrecondition("no estimated pose overlaps the ground truth");

@@ -337,6 +337,26 @@ void Odometry::Update(const UpdateRequest& request, ScanContext* scan) {
   if (scan->out.updated) im.previous_degenerate = scan->out.degenerate;
 }
 
+Eigen::Matrix3d Odometry::PositionCovarianceInG(const ScanOutput& out) {
+  Impl& im = *impl_;
+  const Eigen::Matrix3d R_G_b = out.state.q_G_b.normalized().toRotationMatrix();
+  if (!im.have_anchor && out.map_size > 0) {
+    im.anchor.R_G_b0 = R_G_b;
+    im.anchor.p_lidar0_in_G = out.state.p_b_in_G + R_G_b * lidar_.p_lidar_in_imu_m;
+    im.anchor.p_lidar_in_imu_m = lidar_.p_lidar_in_imu_m;
+    im.have_anchor = true;
+  }
+  constexpr int kP = ErrorStateLayout::kPosition.offset;
+  Eigen::Matrix3d cov = out.covariance.block<3, 3>(kP, kP);
+  if (im.have_anchor) {
+    CalibrationUncertainty calibration;
+    calibration.rotation_sigma_rad = lidar_.calibration_rotation_sigma_deg * M_PI / 180.0;
+    calibration.translation_sigma_m = lidar_.calibration_translation_sigma_m;
+    cov += CalibrationGaugeCovariance(calibration, im.anchor, R_G_b, out.state.p_b_in_G);
+  }
+  return cov;
+}
+
 Status Odometry::Commit(ScanContext* scan, ScanOutput* output) {
   Impl& im = *impl_;
   ScanOutput& out = scan->out;
@@ -346,6 +366,7 @@ Status Odometry::Commit(ScanContext* scan, ScanOutput* output) {
   out.stamp_ns = im.propagator->stamp_ns();
   out.state = scan->x.ego;
   out.covariance = scan->P.topLeftCorner<ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>();
+  out.position_covariance_in_G = PositionCovarianceInG(out);
   out.timings.total_s = SecondsSince(scan->started);
   im.input.MarkProcessed(scan->end_ns);
   ++counters_.scans_processed;

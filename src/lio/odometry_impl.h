@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "swarmlio/lio/calibration_gauge.h"
 #include "swarmlio/lio/imu_initializer.h"
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/in_flight_alignment.h"
@@ -55,6 +56,10 @@ struct Odometry::Impl {
   int64_t seed_window_start_ns = 0;
   internal::InFlightProbe probe;
   bool previous_degenerate = false;  // the last updated scan's flag (front end)
+  // Where the map was anchored (the first commit with a map), for the
+  // calibration's share of the position covariance in G.
+  bool have_anchor = false;
+  MapAnchor anchor;
   ScanContext probe_scan;            // scratch of ProcessReadyScans
   // Scratch reused between scans.
   std::vector<PointXYZT> points_in_b;

@@ -104,6 +104,7 @@ void Odometry::FinishInFlightPass() {
     im.imu_queue.clear();
     im.input.ClearScans();
     im.map = LocalMap(options_.map);
+    im.have_anchor = false;
     im.initializer->Reset();
     im.previous_degenerate = false;
     init_error_ = status.message();
@@ -140,6 +141,7 @@ Status Odometry::RestartFromInFlightStart(const ImuInitialization& start) {
   Impl& im = *impl_;
   SWARMLIO_RETURN_IF_ERROR(im.propagator->Reset(start));
   im.map = LocalMap(options_.map);
+  im.have_anchor = false;
   SWARMLIO_RETURN_IF_ERROR(CreateBackEnd());
   im.imu_queue.assign(im.probe.imu.begin(), im.probe.imu.end());
   im.input.ReplayScans(im.probe.scans);

@@ -55,7 +55,8 @@ void AppendIfUpdated(const lio::ScanOutput& s, eval::CovariantTrajectory* out) {
   T_G_b.translation() = s.state.p_b_in_G;
   out->poses.stamps_s.push_back(ToSeconds(s.stamp_ns));
   out->poses.T_G_b.push_back(T_G_b);
-  out->position_covariances.push_back(
+  out->position_covariances.push_back(s.position_covariance_in_G);
+  out->map_position_covariances.push_back(
       s.covariance.block<3, 3>(ErrorStateLayout::kPosition.offset, ErrorStateLayout::kPosition.offset));
 }
 

@@ -186,8 +186,7 @@ void AddIdentification(const ObserverContext& c, int j, double t0, PairMetrics* 
     const Eigen::Isometry3d T_true = TrueExtrinsic(*c.run, c.observer, j);
     m->initial_error_m = (e.initial_T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm();
     m->initial_error_deg = RotationDeg(T_true.linear().transpose() * e.initial_T_Gi_Gj.R_Ga_Gb());
-    m->wrong_identification = m->initial_error_m > kWrongIdentificationM ||
-                              m->initial_error_deg > kWrongIdentificationDeg;
+    m->wrong_identification = m->initial_error_m > kWrongIdentificationM;
     if ((*c.has_truth)[c.observer] && (*c.has_truth)[j]) {
       // Ground-truth stamps are in each drone's clock, like its bag: j's
       // excitation start moved to i's clock.

@@ -18,10 +18,11 @@ namespace swarmlio::tools {
 /// A teammate is in view in a scan when its body returned at least this many
 /// points (the definition of "in view").
 constexpr int kInViewReturns = 10;
-/// Initial T_Gi_Gj errors beyond which an identification counts as wrong
-/// (a right one starts within a few cm and a degree; docs/replay.md).
+/// Initial T_Gi_Gj position error beyond which an identification counts as
+/// wrong: the match took another drone's or a decoy's track (the drones fly
+/// >= 1 m apart; a right match on a short, poorly excited track can start
+/// several degrees off but within a few centimetres; docs/replay.md).
 constexpr double kWrongIdentificationM = 0.5;
-constexpr double kWrongIdentificationDeg = 5.0;
 
 /// One observer-teammate pair.
 struct PairMetrics {
@@ -46,9 +47,9 @@ struct PairMetrics {
   /// observation of j.
   int scans_in_view = -1;
   int fused_in_view = 0;
-  /// The identification's first T_Gi_Gj is off the truth by more than
-  /// kWrongIdentificationM or kWrongIdentificationDeg: j was matched to the
-  /// wrong track (another drone or a decoy).
+  /// The identification's first T_Gi_Gj position is off the truth by more
+  /// than kWrongIdentificationM: j was matched to the wrong track (another
+  /// drone or a decoy).
   bool wrong_identification = false;
   /// The observer's estimate of the teammate's clock offset at its last scan
   /// minus the truth (TrueClock of the manifest) [ms]; NaN when not estimated.

@@ -14,13 +14,16 @@
 // The estimate's frame is realized only up to a gauge: the first scan anchors
 // the map through the LiDAR-IMU calibration, so a calibration rotation error
 // dR rotates every later position about the start (|p| dR: 0.30 m at 40 m for
-// 0.44 deg in corridor seed 103), which no covariance of a LIO represents
-// (the map is not in the state). The gauge-aligned NEES therefore first
+// 0.44 deg in corridor seed 103). The filter's covariance is relative to its
+// map (the map is not in the state); the odometry adds the calibration's
+// share to the position covariance in G (lio/calibration_gauge.h), which the
+// NEES in G uses. The gauge-aligned NEES (a diagnostic) instead first
 // rotates the ground truth about the first pose onto the estimate (the
 // rotation that best fits the displacements from the first pose: AlignUmeyama
 // without translation), as OpenVINS' ov_eval aligns the ground truth to the
-// estimate before its NEES (ResultTrajectory::calculate_nees). Both are
-// reported; docs/results.md says which band uses which.
+// estimate before its NEES (ResultTrajectory::calculate_nees), with the
+// covariances relative to the map. Both are reported; the acceptance band
+// uses the NEES in G.
 //
 // The estimate is an eval::Trajectory of the updated scans' poses with the
 // covariance of each position; the ground truth an eval::Trajectory. Both are
@@ -50,10 +53,14 @@ namespace swarmlio::eval {
 enum class GroundTruthFrame { kAuto, kG, kOther };
 
 /// An estimate with the covariance of each position p_b_in_G [m^2], one per
-/// pose (a filter's or smoother's output; the updated scans only).
+/// pose (a filter's or smoother's output; the updated scans only): against
+/// the true G (with the map's own uncertainty, lio::ScanOutput::
+/// position_covariance_in_G), and optionally relative to the estimator's own
+/// map (the filter's; empty = the same), which the gauge-aligned NEES uses.
 struct CovariantTrajectory {
   Trajectory poses;
   std::vector<Eigen::Matrix3d> position_covariances;
+  std::vector<Eigen::Matrix3d> map_position_covariances;
 };
 
 struct ConsistencyStats {

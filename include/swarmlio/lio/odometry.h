@@ -115,6 +115,10 @@ class Odometry {
   Odometry(const OdometryOptions& options, const LidarOptions& lidar);
 
   void SeedMapFromStaticStart(int64_t window_start_ns);
+  // The position covariance in G of a committed scan: the filter's plus the
+  // calibration's share about the map anchor (set at the first commit with a
+  // map; ScanOutput::position_covariance_in_G).
+  Eigen::Matrix3d PositionCovarianceInG(const ScanOutput& out);
   // In-flight initialization (odometry_in_flight.cc, docs/imu.md section 1b).
   void StartInFlightProbe(const ImuInitialization& coarse);
   // After a pass: fit v0 and g, then restart from t0 (another pass or the

@@ -74,6 +74,10 @@ struct ScanOutput {
   EgoState state;             // posterior (or prediction when not updated)
   Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim> covariance =
       Eigen::Matrix<double, ErrorStateLayout::kEgoDim, ErrorStateLayout::kEgoDim>::Zero();
+  /// The position block of `covariance` plus the LiDAR-IMU calibration's
+  /// uncertainty, which moves the whole map (lio/calibration_gauge.h): the
+  /// covariance of p_b_in_G against the true G [m^2].
+  Eigen::Matrix3d position_covariance_in_G = Eigen::Matrix3d::Zero();
   bool updated = false;  // false: map initialisation, too few points, failed update
   // The scan arrived while the in-flight initialization's passes ran and was
   // processed when they ended (docs/imu.md section 1b): its output came that

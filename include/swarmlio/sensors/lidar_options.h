@@ -58,6 +58,13 @@ struct LidarOptions {
   TimestampUnit timestamp_unit = TimestampUnit::kNanosecond;
   Eigen::Matrix3d R_imu_lidar = Eigen::Matrix3d::Identity();   // rotation LiDAR -> IMU
   Eigen::Vector3d p_lidar_in_imu_m = Eigen::Vector3d::Zero();  // LiDAR origin in IMU frame [m]
+  // 1-sigma per axis of the calibration above as its user knows it (a good
+  // LiDAR-IMU calibration: a few tenths of a degree, a few millimetres). Not
+  // used to correct anything: the first scan anchors the map through the
+  // calibration, so its error moves the whole map, and the position
+  // covariance in G carries it (lio/calibration_gauge.h).
+  double calibration_rotation_sigma_deg = 0.2;  // [deg]
+  double calibration_translation_sigma_m = 0.005;  // [m]
 
   /// Largest tolerated max |R^T R - I| of R_imu_lidar (4-digit calibrations pass).
   static constexpr double kRotationTolerance = 1e-3;
@@ -96,6 +103,10 @@ struct LidarOptions {
       FieldSpec::InRange(-1.0, 1.0, "", "rotation LiDAR -> IMU (FAST-LIO extrinsic_R)"));
     v("p_lidar_in_imu_m", p_lidar_in_imu_m,
       FieldSpec::InRange(-10.0, 10.0, "m", "LiDAR origin in the IMU frame (FAST-LIO extrinsic_T)"));
+    v("calibration_rotation_sigma_deg", calibration_rotation_sigma_deg,
+      FieldSpec::InRange(0.0, 10.0, "deg", "1-sigma per axis of R_imu_lidar (its calibration)"));
+    v("calibration_translation_sigma_m", calibration_translation_sigma_m,
+      FieldSpec::InRange(0.0, 1.0, "m", "1-sigma per axis of p_lidar_in_imu_m (its calibration)"));
   }
 
   /// "" when valid, else "key: reason".
