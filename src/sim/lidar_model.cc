@@ -15,6 +15,14 @@ namespace {
 // the seed itself, as it always was).
 constexpr uint64_t kImperfectionStream = 1;
 constexpr uint64_t kSecondReturnStream = 2;
+// Sparse-lattice surfaces (Material::return_probability < 1): one
+// counter-based draw per surface crossing, CounterUniform(lattice key, pulse,
+// ray * kMaxLatticeCrossings + crossing).
+constexpr uint64_t kLatticeStream = 3;
+constexpr uint64_t kMaxLatticeCrossings = 16;  // per ray; the last crossing returns
+enum CastRay : uint64_t { kMainRay = 0, kProbeRay = 1 };
+// A ray passing through a lattice surface continues this far past it [m].
+constexpr double kLatticeStepM = 1e-6;
 // Counter-based draws of one pulse (CounterUniform(key, pulse, draw)).
 enum PulseDraw : uint64_t {
   kAngularNoise = 0,  // and 1: a Box-Muller pair
@@ -100,7 +108,8 @@ LidarModel::LidarModel(const SimulatedLidarOptions& options,
       R_imu_lidar_(options.sensor.QuaternionImuLidar().toRotationMatrix()),
       rng_(seed),
       imperfection_key_(DeriveSeed(seed, 0, kImperfectionStream)),
-      second_return_rng_(DeriveSeed(seed, 0, kSecondReturnStream)) {
+      second_return_rng_(DeriveSeed(seed, 0, kSecondReturnStream)),
+      lattice_key_(DeriveSeed(seed, 0, kLatticeStream)) {
   CHECK(options_.Validate().empty()) << options_.Validate();
   CHECK(own_trajectory_ != nullptr && scene_ != nullptr);
   CHECK(scene_->built());
@@ -198,7 +207,7 @@ void LidarModel::SimulatePulse(int64_t k,
   const LidarOptions& sensor = options_.sensor;
   const LidarImperfectionOptions& imp = options_.imperfections;
   const Pulse pulse = AimPulse(k, footprint);
-  const Hit main = Cast(pulse.ray, pulse.t);
+  const Hit main = Cast(pulse.ray, pulse.t, pulse.index, kMainRay);
   // Draw the random numbers for every pulse so that the stream does not
   // depend on the geometry hit.
   const double dropout_draw = (*uniform)(rng_);
@@ -264,7 +273,8 @@ bool LidarModel::ProbeEdge(const Pulse& pulse,
       (pulse.beam_l + radius * (std::cos(angle) * footprint.half_divergence_h * pulse.axis_h +
                                 std::sin(angle) * footprint.half_divergence_v * pulse.axis_v))
           .normalized();
-  *other = Cast(Ray{pulse.ray.origin, pulse.T_W_l.R_W_b * *probe_l}, pulse.t);
+  *other =
+      Cast(Ray{pulse.ray.origin, pulse.T_W_l.R_W_b * *probe_l}, pulse.t, pulse.index, kProbeRay);
   const bool other_surface =
       other->object != main.object || other->hit.primitive != main.hit.primitive;
   return other->hit.hit() && other->hit.t >= options_.sensor.blind_range_m && other_surface &&
@@ -300,10 +310,24 @@ void LidarModel::AppendDualReturn(const Pulse& pulse,
   points->push_back(main_first ? q : p);
 }
 
-LidarModel::Hit LidarModel::Cast(const Ray& ray, double t) const {
+LidarModel::Hit LidarModel::Cast(const Ray& ray, double t, uint64_t pulse, uint64_t ray_id) const {
+  double t_min = 0.0;
+  for (uint64_t crossing = 0;; ++crossing) {
+    const Hit h = CastFrom(ray, t, t_min);
+    if (!h.hit.hit() || h.material->return_probability >= 1.0 ||
+        crossing + 1 >= kMaxLatticeCrossings) {
+      return h;
+    }
+    const uint64_t draw = ray_id * kMaxLatticeCrossings + crossing;
+    if (CounterUniform(lattice_key_, pulse, draw) <= h.material->return_probability) return h;
+    t_min = h.hit.t + kLatticeStepM;  // through the lattice
+  }
+}
+
+LidarModel::Hit LidarModel::CastFrom(const Ray& ray, double t, double t_min) const {
   const double max_range = options_.sensor.max_range_m;
   Hit h;
-  if (scene_->Intersect(ray, 0.0, max_range, &h.hit)) {
+  if (scene_->Intersect(ray, t_min, max_range, &h.hit)) {
     h.material = &scene_->primitives()[h.hit.primitive].material();
   }
   for (const Candidate& c : candidates_) {
@@ -314,7 +338,7 @@ LidarModel::Hit LidarModel::Cast(const Ray& ray, double t) const {
     const Ray ray_o{T_W_o.R_W_b.transpose() * (ray.origin - T_W_o.p_b_in_W),
                     T_W_o.R_W_b.transpose() * ray.direction};
     RayHit hit_o;
-    if (IntersectBruteForce(obj.parts_b, ray_o, 0.0, h.hit.hit() ? h.hit.t : max_range, &hit_o)) {
+    if (IntersectBruteForce(obj.parts_b, ray_o, t_min, h.hit.hit() ? h.hit.t : max_range, &hit_o)) {
       h.hit = hit_o;
       h.hit.normal = T_W_o.R_W_b * hit_o.normal;
       h.object = c.object;

@@ -65,6 +65,9 @@ std::string ResolvedScenarioYaml(const Scenario& s, const Simulator& sim) {
                               config::DumpOptions(d.imu, "imu") +
                               config::DumpOptions(d.body, "body");
     os << Indented(block, "    ");
+    os << "    # centroid of the airframe's reflective parts in the body (IMU) frame b\n";
+    os << "    p_reflective_centroid_in_b_m: "
+       << Vec(ReflectiveCentroidInBody(MakeDroneBody(d.body))) << "\n";
     const SensorCalibration truth = TrueCalibration(d);
     const SensorCalibration given = GivenCalibration(d);
     const ImuErrors imu = sim.ImuErrorsOf(static_cast<int>(i));

@@ -92,6 +92,18 @@ Status ResolveDroneSensors(const config::ConfigFile& file,
   return Status::Ok();
 }
 
+// The drone's airframe: the defaults of its `body.model`, with its `body:`
+// keys read over them (and validated).
+Status ResolveDroneBody(const config::ConfigFile& file,
+                        const std::string& key,
+                        const DroneSpec& drone,
+                        DroneBodyOptions* body) {
+  DroneBodyOptions resolved = DroneBodyOptions::ForModel(drone.body.options.model);
+  SWARMLIO_RETURN_IF_ERROR(file.Read(key + ".body", &resolved));
+  *body = resolved;
+  return Status::Ok();
+}
+
 void AddArena(const ArenaSpec& a, Scene* scene) {
   if ((a.size_m.array() <= 0.0).any()) return;
   AddRoom(a.floor_center_m, a.size_m, a.wall_thickness_m, Material::Diffuse(a.albedo_percent),
@@ -219,7 +231,7 @@ Status BuildScenario(const config::ConfigFile& file,
     c.trajectory = d.motion.Build(DeriveSeed(seed, i, streams::kTrajectory), duration_s);
     c.lidar = d.lidar;
     c.imu = d.imu;
-    c.body = d.body;
+    SWARMLIO_RETURN_IF_ERROR(ResolveDroneBody(file, key, d, &c.body));
     c.clock_offset_s = d.clock_offset_s;
     c.clock_drift_ppm = d.clock_drift_ppm;
     DrawDroneImperfections(imperfections, seed, i, &c);

@@ -228,6 +228,18 @@ struct MotionSpec {
   }
 };
 
+// The `body:` map as read in the first pass: its keys and types are checked,
+// its values only once applied over the defaults of its `model`
+// (ResolveDroneBody in scenario.cc), since they may rely on them.
+struct DeferredBody {
+  DroneBodyOptions options;
+  template <class V>
+  void VisitFields(V&& v) {
+    options.VisitFields(v);
+  }
+  std::string Validate() const { return {}; }
+};
+
 struct DroneSpec {
   MotionSpec motion;
   std::string sensor_preset;  // "" = the sensor structs' defaults
@@ -235,7 +247,7 @@ struct DroneSpec {
   double clock_drift_ppm = 0.0;
   SimulatedLidarOptions lidar;
   SimulatedImuOptions imu;
-  DroneBodyOptions body;
+  DeferredBody body;  // the airframe, resolved by ResolveDroneBody (scenario.cc)
   template <class V>
   void VisitFields(V&& v) {
     motion.VisitFields(v);
@@ -247,7 +259,7 @@ struct DroneSpec {
       FieldSpec::InRange(-1000, 1000, "ppm", "clock rate error (plus imperfections.clock)"));
     v("lidar", lidar);
     v("imu", imu);
-    v("body", body);
+    v("body", body, FieldSpec::Doc("airframe: `model` and overrides of its defaults"));
   }
   std::string Validate() const {
     // The sensors are validated once merged over the preset and the

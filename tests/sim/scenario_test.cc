@@ -252,9 +252,8 @@ TEST(Scenario, AFlightThroughASolidIsAnError) {
 }
 
 TEST(Scenario, ShippedScenariosLoad) {
-  for (const char* name :
-       {"indoor_3uav", "wall_degenerate", "corridor", "exploration", "decoys", "swarm_40",
-        "relay_3uav"}) {
+  for (const char* name : {"indoor_3uav", "wall_degenerate", "corridor", "exploration", "decoys",
+                           "swarm_40", "relay_3uav", "airframes"}) {
     Scenario s;
     const Status status =
         LoadScenario(std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/" + name + ".yaml", &s);

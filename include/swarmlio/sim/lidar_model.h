@@ -4,6 +4,10 @@
 // noise, range noise growing with range and incidence, range walk on dark
 // surfaces, mixed pixels and multiple returns at depth edges, range-dependent
 // dropouts) are in LidarImperfectionOptions (lidar_options.h), off by default.
+// A surface whose Material::return_probability is below 1 is a sparse lattice
+// (the reflective_shell airframe, drone_body.h): a ray crossing it returns from
+// it with that probability, else passes through to what lies behind, drawn per
+// pulse and crossing from the LiDAR's seed (deterministic, thread-independent).
 #pragma once
 
 #include <Eigen/Core>
@@ -78,7 +82,12 @@ class LidarModel {
     int object = -1;
     const Material* material = nullptr;
   };
-  Hit Cast(const Ray& ray, double t) const;
+  // The surface ray `ray_id` (kMainRay, kProbeRay) of pulse `pulse` returns
+  // from: the closest one, or past sparse-lattice surfaces it passes through
+  // (Material::return_probability, counter-based draws of lattice_key_).
+  Hit Cast(const Ray& ray, double t, uint64_t pulse, uint64_t ray_id) const;
+  // The closest surface with ray parameter >= t_min.
+  Hit CastFrom(const Ray& ray, double t, double t_min) const;
 
   // The beam shape of the imperfections, the same for every pulse [rad].
   struct Footprint {
@@ -140,6 +149,7 @@ class LidarModel {
   std::mt19937_64 rng_;                // range noise, random dropouts, reflectivity
   uint64_t imperfection_key_;          // LidarImperfectionOptions: CounterUniform(key, pulse, draw)
   std::mt19937_64 second_return_rng_;  // reflectivity of second returns
+  uint64_t lattice_key_;               // sparse-lattice surfaces: CounterUniform(key, pulse, draw)
   std::vector<Candidate> candidates_;
 };
 

@@ -18,18 +18,39 @@ struct Ray {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
 };
 
-enum class SurfaceType { kDiffuse, kRetroReflective };
+enum class SurfaceType { kDiffuse, kRetroReflective, kConstantIntensity };
 
 /// Surface material. For kDiffuse, `reflectivity_percent` is the Lambertian
 /// albedo (0-100 %); for kRetroReflective it is the tape's gain relative to a
-/// fresh tape (0-100 %, 100 = new tape).
+/// fresh tape (0-100 %, 100 = new tape), and the returned intensity lies in
+/// [intensity_min, intensity_max] (the Livox retro-reflective range 151-255 by
+/// default; a lower band models a dim tape, reflectivity.h). kConstantIntensity
+/// returns an intensity drawn uniformly from the integers in [intensity_min,
+/// intensity_max] whatever the range and incidence. `return_probability` < 1
+/// makes the surface a sparse lattice: each ray crossing it returns from it
+/// with that probability and otherwise passes through (lidar_model.h).
 struct Material {
   SurfaceType type = SurfaceType::kDiffuse;
   double reflectivity_percent = 50.0;
+  double intensity_min = 151.0;     // Livox 0-255 (retro-reflective, constant intensity)
+  double intensity_max = 255.0;     // Livox 0-255
+  double return_probability = 1.0;  // per ray crossing the surface, in (0, 1]
 
   static Material Diffuse(double percent) { return {SurfaceType::kDiffuse, percent}; }
   static Material RetroReflective(double gain_percent = 100.0) {
     return {SurfaceType::kRetroReflective, gain_percent};
+  }
+  /// Tape whose intensity spans [intensity_min, intensity_max] instead of 151-255.
+  static Material RetroReflectiveBand(double gain_percent,
+                                      double intensity_min,
+                                      double intensity_max) {
+    return {SurfaceType::kRetroReflective, gain_percent, intensity_min, intensity_max};
+  }
+  static Material ConstantIntensity(double intensity_min,
+                                    double intensity_max,
+                                    double return_probability = 1.0) {
+    return {SurfaceType::kConstantIntensity, 100.0, intensity_min, intensity_max,
+            return_probability};
   }
 };
 

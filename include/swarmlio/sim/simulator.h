@@ -83,7 +83,7 @@ struct DroneStats {
   int64_t scans = 0;
   int64_t points = 0;
   int64_t points_on_teammates = 0;   // returns from other drones' bodies
-  int64_t tape_points = 0;           // returns from retro-reflective surfaces
+  int64_t tape_points = 0;           // returns above 150 (the Livox retro-reflective range)
   int64_t scans_seeing_teammates = 0;
 };
 
