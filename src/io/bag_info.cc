@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include "src/io/bag_source.h"
+#include "src/io/mcap_source.h"
 #include "swarmlio/common/check.h"
 
 namespace swarmlio::io {
@@ -14,6 +15,7 @@ Status ReadBagInfo(const std::string& path, BagInfo* info, bool recover_damaged_
   CHECK(info != nullptr);
   *info = BagInfo();
   info->path = path;
+  info->format = internal::HasMcapMagic(path) ? "mcap" : "ros1";
   internal::BagSourceOptions options;
   options.verify_chunks = false;
   options.recover = recover_damaged_bags;
@@ -33,6 +35,7 @@ Status ReadBagInfo(const std::string& path, BagInfo* info, bool recover_damaged_
     topic.topic = c.topic;
     topic.datatype = c.datatype;
     topic.md5sum = c.md5sum;
+    topic.encoding = c.encoding;
     internal::TopicSummary summary;
     SWARMLIO_RETURN_IF_ERROR(source->Summarize(c.topic, &summary));
     topic.message_count = summary.message_count;

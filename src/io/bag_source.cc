@@ -12,6 +12,7 @@
 #include "src/io/bag_common.h"
 #include "src/io/bag_precheck.h"
 #include "src/io/bag_recovery.h"
+#include "src/io/mcap_source.h"
 #include "src/io/ros_time.h"
 #include "swarmlio/common/check.h"
 
@@ -259,6 +260,8 @@ Status BagSource::Open(const std::string& path,
                        std::unique_ptr<BagSource>* source) {
   CHECK(source != nullptr);
   source->reset();
+  // The format is told by the magic bytes, whatever the extension.
+  if (HasMcapMagic(path)) return OpenMcapSource(path, options, source);
   auto healthy = std::make_unique<RosbagSource>(path);
   BagPrecheckResult precheck;
   const Status opened = OpenBagForReading(path, options.verify_chunks, healthy->bag(), &precheck);
