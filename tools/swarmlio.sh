@@ -39,7 +39,7 @@ PACKAGES=(
   libnanoflann-dev robin-map-dev libtbb-dev
   libcairo2-dev
   libsodium-dev
-  libzstd-dev liblz4-dev zlib1g-dev
+  libzstd-dev liblz4-dev zlib1g-dev libsqlite3-dev
 )
 # The fuzz stage needs clang and its libFuzzer/sanitizer runtimes.
 case "${1:-}" in

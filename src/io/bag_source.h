@@ -1,8 +1,9 @@
 // Where the bag reader and ReadBagInfo get messages from: rosbag's index for
 // a healthy ROS1 bag, a scan of the records (bag_recovery.h) for a truncated
-// or unindexed one, or a scan of an MCAP file (mcap_source.h; told by its
-// magic bytes, not its extension). Both give the connections, the time range, and per topic
-// the messages in bag-time order, as raw bytes.
+// or unindexed one, a scan of an MCAP file (mcap_source.h), a rosbag2 SQLite3
+// file (db3_source.h) -- each told by its magic bytes, not its extension --
+// or a rosbag2 folder of such files (rosbag2_folder.h). Both give the connections, the time range,
+// and per topic the messages in bag-time order, as raw bytes.
 #pragma once
 
 #include <cstddef>

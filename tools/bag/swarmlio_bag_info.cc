@@ -1,5 +1,6 @@
 // swarmlio_bag_info: prints the topics, message types, counts and time range
-// of a ROS1 bag or an MCAP file (ROS 2; told by its magic bytes) (of a
+// of a ROS1 bag, an MCAP file or a rosbag2 .db3 file or folder (ROS 2; told
+// by its magic bytes) (of a
 // truncated or unindexed bag: what a scan of its records
 // recovered and what was lost), then reads the IMU / LiDAR / ground-truth
 // topics with BagReader (topics found by type when absent) and prints its
@@ -66,7 +67,7 @@ int Fail(const std::string& message) {
 
 void PrintInfo(const io::BagInfo& info) {
   std::printf("path:      %s\n", info.path.c_str());
-  std::printf("format:    %s\n", info.format == "mcap" ? "MCAP" : "ROS1 bag");
+  std::printf("format:    %s\n", info.format == "ros1" ? "ROS1 bag" : info.format.c_str());
   std::printf("size:      %" PRIu64 " bytes (%.1f MiB)\n", info.file_size_bytes,
               static_cast<double>(info.file_size_bytes) / (1024.0 * 1024.0));
   std::printf("messages:  %" PRId64 "\n", info.message_count);
@@ -95,7 +96,8 @@ void PrintInfo(const io::BagInfo& info) {
 int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "prints topics, types, counts, time range and reader statistics of a "
-      "ROS1 bag or MCAP file\n  usage: swarmlio_bag_info [flags] <bag or .mcap>");
+      "ROS1 bag, MCAP file, rosbag2 .db3 file or folder\n  usage: swarmlio_bag_info [flags] "
+      "<bag, .mcap, .db3 or rosbag2 folder>");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;

@@ -44,6 +44,16 @@ DEFINE_string(imperfections,
 namespace swarmlio::sim {
 namespace {
 
+// --bag_format over the scenario's bag.format; false (printed) if invalid.
+bool ApplyBagFormatFlag(io::BagWriterOptions* bag) {
+  if (FLAGS_bag_format.empty() || config::EnumFromString(FLAGS_bag_format, &bag->format)) {
+    return true;
+  }
+  std::fprintf(stderr, "error: --bag_format '%s' is not one of %s\n", FLAGS_bag_format.c_str(),
+               config::EnumChoices<io::BagFormat>().c_str());
+  return false;
+}
+
 int Main() {
   if (FLAGS_scenario.empty() || FLAGS_output_dir.empty()) {
     std::fprintf(
@@ -67,12 +77,7 @@ int Main() {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());
     return 1;
   }
-  if (!FLAGS_bag_format.empty() &&
-      !swarmlio::config::EnumFromString(FLAGS_bag_format, &scenario.bag.format)) {
-    std::fprintf(stderr, "error: --bag_format '%s' is not one of %s\n", FLAGS_bag_format.c_str(),
-                 swarmlio::config::EnumChoices<swarmlio::io::BagFormat>().c_str());
-    return 2;
-  }
+  if (!ApplyBagFormatFlag(&scenario.bag)) return 2;
   if (FLAGS_duration_s > 0) scenario.options.duration_s = FLAGS_duration_s;
   if (FLAGS_seed >= 0) scenario.options.seed = FLAGS_seed;
   if (FLAGS_threads > 0) scenario.options.num_threads = FLAGS_threads;

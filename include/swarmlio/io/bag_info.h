@@ -1,5 +1,6 @@
-// Summary of a ROS1 bag from its index, or of an MCAP file from a scan of its
-// data section (no message is decoded). A truncated or unindexed bag is
+// Summary of a ROS1 bag from its index, of an MCAP file from a scan of its
+// data section, of a rosbag2 .db3 file or folder from its tables (no message
+// is decoded). A truncated or unindexed bag is
 // summarized from a scan of its records (recovery).
 #pragma once
 
@@ -24,7 +25,7 @@ struct BagTopicInfo {
 
 struct BagInfo {
   std::string path;
-  std::string format;  // "ros1" or "mcap" (told by the magic bytes)
+  std::string format;  // "ros1", "mcap", "db3" (told by the magic bytes) or "rosbag2" (a folder)
   uint64_t file_size_bytes = 0;
   int64_t message_count = 0;
   int64_t start_time_ns = 0;         // bag time of the first message (0 if empty)
