@@ -14,6 +14,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A metadata.yaml path in the folder; ROS 2 Foxy wrote them prefixed with the
+// folder's own name, so an absent path is also tried by its file name alone.
+std::string StoragePath(const std::string& folder, const std::string& relative) {
+  const fs::path path = fs::path(folder) / relative;
+  std::error_code ec;
+  if (fs::exists(path, ec)) return path.string();
+  const fs::path by_name = fs::path(folder) / fs::path(relative).filename();
+  return fs::exists(by_name, ec) ? by_name.string() : path.string();
+}
+
 // The storage files of the folder, in recording order.
 Status StorageFiles(const std::string& folder, std::vector<std::string>* files) {
   files->clear();
@@ -28,8 +38,7 @@ Status StorageFiles(const std::string& folder, std::vector<std::string>* files) 
                                 "': metadata.yaml has no "
                                 "rosbag2_bagfile_information.relative_file_paths list");
       }
-      for (const YAML::Node& p : paths)
-        files->push_back((fs::path(folder) / p.as<std::string>()).string());
+      for (const YAML::Node& p : paths) files->push_back(StoragePath(folder, p.as<std::string>()));
     } catch (const std::exception& e) {
       return Status::DataLoss("bag '" + folder + "': metadata.yaml: " + e.what());
     }

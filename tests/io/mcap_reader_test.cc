@@ -4,6 +4,7 @@
 // chunk CRCs, truncated and unfinished files give every complete record
 // before the damage; overwritten bytes never crash.
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <fstream>
@@ -355,6 +356,52 @@ TEST(McapReaderTest, OverwrittenBytesNeverCrash) {
     EXPECT_GT(ok, 0);
     EXPECT_GT(errors, 0);
   }
+}
+
+uint64_t Le(const Bytes& bytes, size_t at, size_t n) {
+  uint64_t value = 0;
+  for (size_t k = 0; k < n; ++k) value |= static_cast<uint64_t>(bytes.at(at + k)) << (8 * k);
+  return value;
+}
+
+// Our writer's file checked against the spec byte by byte (not with our
+// reader, which skips the summary): DataEnd's data CRC, the footer's summary
+// CRC, Statistics, and every ChunkIndex pointing at its chunk.
+TEST(McapReaderTest, WrittenSummaryAndFooterFollowTheSpec) {
+  TempDir dir;
+  BagWriterOptions options;
+  options.compression = BagCompression::kZstd;
+  testing::WriteSimpleBag(dir.File("run.mcap"), options, 2000, 400);  // several chunks
+  const Bytes b = ReadFile(dir.File("run.mcap"));
+  ASSERT_GT(b.size(), 8u + 9u + 20u + 8u);
+  EXPECT_TRUE(std::equal(b.end() - 8, b.end(), b.begin()));  // the magic at both ends
+  const size_t footer = b.size() - 8 - 9 - 20;
+  ASSERT_EQ(b[footer], 0x02);
+  ASSERT_EQ(Le(b, footer + 1, 8), 20u);
+  const size_t summary_start = Le(b, footer + 9, 8);
+  EXPECT_EQ(Le(b, footer + 17, 8), 0u);
+  EXPECT_EQ(Le(b, footer + 25, 4), crc32(0, b.data() + summary_start, footer + 25 - summary_start));
+  // DataEnd right before the summary, with the CRC of everything before it.
+  const size_t data_end = summary_start - 9 - 4;
+  ASSERT_EQ(b[data_end], 0x0F);
+  EXPECT_EQ(Le(b, data_end + 9, 4), crc32(0, b.data(), data_end));
+  int chunk_indexes = 0;
+  for (size_t at = summary_start; at < footer;) {
+    const uint64_t length = Le(b, at + 1, 8);
+    const size_t content = at + 9;
+    if (b[at] == 0x0B) {
+      EXPECT_EQ(Le(b, content, 8), 2000u + 100u + 200u);  // message_count
+    }
+    if (b[at] == 0x08) {
+      ++chunk_indexes;
+      const size_t chunk = Le(b, content + 16, 8);
+      EXPECT_EQ(b.at(chunk), 0x06);
+      EXPECT_EQ(Le(b, content + 24, 8), 9 + Le(b, chunk + 1, 8));  // chunk_length
+    }
+    at = content + length;
+    ASSERT_LE(at, footer);
+  }
+  EXPECT_GT(chunk_indexes, 1);
 }
 
 }  // namespace

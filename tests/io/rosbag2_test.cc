@@ -145,6 +145,11 @@ TEST_F(Rosbag2Test, SplitFolderReadsAsOneLog) {
   EXPECT_EQ(info.format, "rosbag2");
   EXPECT_EQ(info.message_count, 230);
   EXPECT_EQ(info.topics[1].message_count, 200);
+  // ROS 2 Foxy's metadata.yaml prefixed the paths with the folder's name.
+  WriteText(folder + "/metadata.yaml",
+            Metadata("sqlite3", {"split/split_0.db3", "split/split_1.db3"}));
+  ASSERT_TRUE(ReadAll(folder, BagReaderOptions(), &records).ok());
+  ExpectSameRecords(records, expected_);
   // Without metadata.yaml: the .db3 files in name order.
   std::filesystem::remove(folder + "/metadata.yaml");
   ASSERT_TRUE(ReadAll(folder, BagReaderOptions(), &records).ok());
