@@ -106,6 +106,19 @@ Status DecompressMcapChunk(const std::string& compression,
                             "' (supported: none, zstd, lz4)");
   }
   SWARMLIO_RETURN_IF_ERROR(CheckSizes(compression, size, uncompressed_size));
+  if (compression == "zstd") {
+    // The first frame's stated size must fit before anything is allocated
+    // (a chunk may hold several frames, so it may be smaller).
+    const unsigned long long frame_size = ZSTD_getFrameContentSize(data, size);
+    if (frame_size != ZSTD_CONTENTSIZE_UNKNOWN &&
+        (frame_size == ZSTD_CONTENTSIZE_ERROR || frame_size > uncompressed_size)) {
+      return Status::DataLoss("zstd frame holds " +
+                              (frame_size == ZSTD_CONTENTSIZE_ERROR
+                                   ? std::string("no valid header")
+                                   : std::to_string(frame_size) + " bytes") +
+                              ", the chunk says " + std::to_string(uncompressed_size));
+    }
+  }
   if (compression.empty()) {
     out->assign(data, data + size);
     return Status::Ok();
