@@ -16,6 +16,7 @@
 #include "src/io/cdr_serialize.h"
 #include "src/io/custom_msg_codec.h"
 #include "src/io/imu_codec.h"
+#include "src/io/message_types.h"
 #include "src/io/pose_codec.h"
 #include "swarmlio/io/bag_info.h"
 #include "tests/io/bag_test_util.h"
@@ -314,6 +315,48 @@ TEST(McapReaderTest, ChannelsInAnotherEncodingAreNotTaken) {
   by_type.imu_topic = kAutoTopic;
   status = ReadAll(dir.File("json.mcap"), by_type, &records);
   EXPECT_EQ(status.code(), Status::Code::kNotFound) << status.message();
+}
+
+// MCAP can carry ROS1 messages too ("ros1" encoding, ROS1 type names): read
+// with the ROS1 decoders when the channel's md5sum metadata matches.
+TEST(McapReaderTest, Ros1EncodedChannelsAreReadWithTheirMd5) {
+  TempDir dir;
+  for (bool with_md5 : {true, false}) {
+    McapBuilder builder;
+    builder.Add(0x03, McapBuilder::Schema(1, "sensor_msgs/Imu", "ros1msg"));
+    builder.Add(0x03, McapBuilder::Schema(2, "livox_ros_driver/CustomMsg", "ros1msg"));
+    builder.Add(0x04, McapBuilder::Channel(
+                          0, 1, "/livox/imu", "ros1",
+                          with_md5 ? internal::ExpectedRos1Md5(internal::MessageKind::kImu) : ""));
+    builder.Add(0x04,
+                McapBuilder::Channel(1, 2, "/livox/lidar", "ros1", internal::kLivoxCustomMsgMd5));
+    for (int i = 0; i < 20; ++i) {
+      const int64_t t = kT0 + i * kImuPeriodNs;
+      sensor_msgs::Imu imu;
+      ASSERT_TRUE(internal::EncodeImu(testing::MakeImu(i, t), 0, &imu).ok());
+      builder.Add(0x05, McapBuilder::Message(0, static_cast<uint64_t>(t), testing::Serialize(imu)));
+      if (i % 10 == 0) {
+        internal::LivoxCustomMsg scan;
+        ASSERT_TRUE(
+            internal::EncodeLivoxCustomMsg(testing::MakeLivoxScan(i, t, 12), 0, &scan).ok());
+        builder.Add(0x05,
+                    McapBuilder::Message(1, static_cast<uint64_t>(t), testing::Serialize(scan)));
+      }
+    }
+    WriteFile(dir.File("ros1.mcap"), builder.Finish());
+    std::vector<BagRecord> records;
+    const Status status = ReadAll(dir.File("ros1.mcap"), BagReaderOptions(), &records);
+    if (!with_md5) {
+      EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
+      EXPECT_TRUE(Contains(status.message(), "MD5")) << status.message();
+      continue;
+    }
+    ASSERT_TRUE(status.ok()) << status.message();
+    const std::vector<ImuSample> imu = Select<ImuSample>(records);
+    ASSERT_EQ(imu.size(), 20u);
+    testing::ExpectImuEqual(imu[7], testing::MakeImu(7, kT0 + 7 * kImuPeriodNs));
+    EXPECT_EQ(Select<LidarScan>(records).size(), 2u);
+  }
 }
 
 // The ROS1 mutation checks (bag_reader_error_test.cc, bag_recovery_test.cc)

@@ -41,7 +41,8 @@ class McapBuilder {
   static Bytes Channel(uint16_t id,
                        uint16_t schema,
                        const std::string& topic,
-                       const std::string& encoding) {
+                       const std::string& encoding,
+                       const std::string& md5sum = "") {
     Bytes c;
     Int<uint16_t>(&c, id);
     Int<uint16_t>(&c, schema);
@@ -50,6 +51,10 @@ class McapBuilder {
     Bytes map;
     Str(&map, "offered_qos_profiles");
     Str(&map, "");
+    if (!md5sum.empty()) {
+      Str(&map, "md5sum");
+      Str(&map, md5sum);
+    }
     Int<uint32_t>(&c, static_cast<uint32_t>(map.size()));
     c.insert(c.end(), map.begin(), map.end());
     return c;
