@@ -5,7 +5,7 @@
 #   tools/swarmlio.sh demo    setup, then run the main job on the built-in default scenario
 #   tools/swarmlio.sh test    setup, run all tests; then build with ASan+UBSan and run them again
 #                             (all but the whole-scenario accuracy flights: SANITIZER_SKIP);
-#                             then fuzz the packet decoder (clang, libFuzzer) and run the threaded
+#                             then fuzz the packet decoder and the MCAP reader (clang, libFuzzer) and run the threaded
 #                             tests under ThreadSanitizer (docs/network.md, "Fuzzing and sanitizers in CI")
 #   tools/swarmlio.sh fuzz    only the fuzz stage;  tools/swarmlio.sh tsan   only the TSan stage
 #   tools/swarmlio.sh tidy    only the static checks: clang-tidy (.clang-tidy: function size
@@ -14,7 +14,7 @@
 #
 # Environment: BUILD_DIR (default build), ASAN_BUILD_DIR (default build-asan),
 # FUZZ_BUILD_DIR (default build-fuzz), TSAN_BUILD_DIR (default build-tsan),
-# FUZZ_RUNS (default 1000000), FUZZ_MAX_TIME_S (default 300),
+# FUZZ_RUNS (default 1000000), FUZZ_MAX_TIME_S (default 300), MCAP_FUZZ_MAX_TIME_S (default 60),
 # JOBS (default 2), CI=true turns warnings into errors.
 set -euo pipefail
 
@@ -25,6 +25,7 @@ FUZZ_BUILD_DIR="${FUZZ_BUILD_DIR:-$ROOT/build-fuzz}"
 TSAN_BUILD_DIR="${TSAN_BUILD_DIR:-$ROOT/build-tsan}"
 FUZZ_RUNS="${FUZZ_RUNS:-1000000}"
 FUZZ_MAX_TIME_S="${FUZZ_MAX_TIME_S:-300}"
+MCAP_FUZZ_MAX_TIME_S="${MCAP_FUZZ_MAX_TIME_S:-60}"
 JOBS="${JOBS:-2}"
 WERROR=OFF
 if [[ "${CI:-}" == "true" ]]; then WERROR=ON; fi
@@ -39,6 +40,7 @@ PACKAGES=(
   libnanoflann-dev robin-map-dev libtbb-dev
   libcairo2-dev
   libsodium-dev
+  libzstd-dev liblz4-dev zlib1g-dev libsqlite3-dev
 )
 # The fuzz stage needs clang and its libFuzzer/sanitizer runtimes.
 case "${1:-}" in
@@ -79,8 +81,9 @@ SANITIZER_BUILD_TYPE=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWI
 # stays in with DroneEstimator.IdentifiesATeammate...), the window of one (the
 # window of five stays), the replay's dropped-scans list (the same-seed replay
 # stays), two of the three restart re-identifications, the spinning foreign
-# bag (the sign-flipped one stays).
-SANITIZER_SKIP='^((InFlightStartTest|WindowSwarmTest|SwarmEndToEndTest|SwarmClockTest)\.[A-Za-z]+|ClockSyncSimulation\.SymmetricJitterNeedsManyExchanges|OdometryEndToEnd\.ConsistentOnTheRealisticSimulatorOnAHeldOutSeed|TeammateEndToEnd\.Uav2IdentifiesBothTeammatesInIndoor3uavOnEstimatedPoses|SwarmReplayTest\.SingleAgentAblationFusesNothingButKeepsMessaging|DroneEstimator\.(AnEntryOverdueOnASaturatedBudgetGoesOutLikeANewOne|KeepsItsBroadcastWithinTheByteBudget|WithoutGraphThroughDerivedARestartedTeammateStaysUnknown|ReidentifiesARestartedTeammateThroughTheInverseOfADerivedEntry)|WindowOdometry\.WindowOfOneReproducesTheFilter|SwarmReplayTest\.LeavesOutTheListedScans|ForeignBagTest\.SpinningCloudWithoutPointTimeTracksLikeTheOriginal)$'
+# bag (the sign-flipped one stays), the same flight from MCAP (the MCAP reader
+# and writer stay under the sanitizers in McapReaderTest and Rosbag2Test).
+SANITIZER_SKIP='^((InFlightStartTest|WindowSwarmTest|SwarmEndToEndTest|SwarmClockTest)\.[A-Za-z]+|ClockSyncSimulation\.SymmetricJitterNeedsManyExchanges|OdometryEndToEnd\.ConsistentOnTheRealisticSimulatorOnAHeldOutSeed|TeammateEndToEnd\.Uav2IdentifiesBothTeammatesInIndoor3uavOnEstimatedPoses|SwarmReplayTest\.SingleAgentAblationFusesNothingButKeepsMessaging|DroneEstimator\.(AnEntryOverdueOnASaturatedBudgetGoesOutLikeANewOne|KeepsItsBroadcastWithinTheByteBudget|WithoutGraphThroughDerivedARestartedTeammateStaysUnknown|ReidentifiesARestartedTeammateThroughTheInverseOfADerivedEntry)|WindowOdometry\.WindowOfOneReproducesTheFilter|SwarmReplayTest\.LeavesOutTheListedScans|ForeignBagTest\.(SpinningCloudWithoutPointTimeTracksLikeTheOriginal|SameFlightFromMcapGivesTheSameTrajectory))$'
 
 install_packages() {
   local missing=()
@@ -159,6 +162,32 @@ fuzz_stage() {
     log "fuzz stage FAILED: only ${executed:-0} of $FUZZ_RUNS executions within ${FUZZ_MAX_TIME_S} s"
     return 1
   fi
+  mcap_fuzz
+}
+
+# The MCAP reader (BagReader, ReadBagInfo; file-based, ~500 inputs/s) for
+# MCAP_FUZZ_MAX_TIME_S from seeds the target writes. A crash, a sanitizer
+# report or a timeout fails.
+mcap_fuzz() {
+  CC=clang CXX=clang++ configure_and_build_targets "$FUZZ_BUILD_DIR" swarmlio_mcap_reader_fuzz \
+    "${SANITIZER_BUILD_TYPE[@]}" -DSWARMLIO_FUZZ=ON -DBUILD_TESTING=OFF \
+    -DSWARMLIO_BUILD_BENCHMARKS=OFF
+  local bin="$FUZZ_BUILD_DIR/tools/fuzz/swarmlio_mcap_reader_fuzz"
+  local work="$FUZZ_BUILD_DIR/mcap-fuzz-run"
+  rm -rf "$work"
+  mkdir -p "$work/seeds" "$work/corpus" "$work/artifacts"
+  "$bin" --write_seeds="$work/seeds"
+  log "fuzzing the MCAP reader for ${MCAP_FUZZ_MAX_TIME_S} s, log in $work/fuzz.log"
+  local rc=0
+  "$bin" -max_total_time="$MCAP_FUZZ_MAX_TIME_S" -timeout=10 -max_len=20000 -print_final_stats=1 \
+    -artifact_prefix="$work/artifacts/" "$work/corpus" "$work/seeds" >"$work/fuzz.log" 2>&1 || rc=$?
+  if [[ $rc -ne 0 ]]; then
+    tail -n 60 "$work/fuzz.log" >&2
+    log "MCAP fuzz FAILED (exit $rc); reproduce with: $bin $work/artifacts/<file>"
+    return 1
+  fi
+  log "MCAP fuzz: $(sed -n 's/^stat::number_of_executed_units: *//p' "$work/fuzz.log") executions," \
+    "0 crashes"
 }
 
 # ThreadSanitizer on the tests that run more than one thread: the simulator's

@@ -25,6 +25,24 @@ std::string BagReaderOptions::Validate() const {
   return error;
 }
 
+std::string CheckCompressionFor(BagFormat format, BagCompression compression) {
+  if (format == BagFormat::kRos1 && compression == BagCompression::kZstd) {
+    return "compression: zstd is for MCAP files (ROS1 bags: none, lz4, bz2)";
+  }
+  if (format == BagFormat::kMcap && compression == BagCompression::kBz2) {
+    return "compression: bz2 is for ROS1 bags (MCAP files: none, lz4, zstd)";
+  }
+  return "";
+}
+
+BagFormat ResolveBagFormat(BagFormat format, const std::string& path) {
+  if (format != BagFormat::kAuto) return format;
+  const std::string extension = ".mcap";
+  const bool mcap = path.size() >= extension.size() &&
+                    path.compare(path.size() - extension.size(), extension.size(), extension) == 0;
+  return mcap ? BagFormat::kMcap : BagFormat::kRos1;
+}
+
 std::string BagWriterOptions::Validate() const {
   std::string error = config::ValidateFields(*this);
   if (error.empty()) error = CheckTopic("imu_topic", imu_topic, true);
@@ -35,6 +53,7 @@ std::string BagWriterOptions::Validate() const {
     error = "imu_topic, lidar_topic, ground_truth_topic: must be distinct";
   }
   if (error.empty() && point_time_field.empty()) error = "point_time_field: must not be empty";
+  if (error.empty()) error = CheckCompressionFor(format, compression);
   for (const char* name : kWrittenFieldNames) {
     if (error.empty() && point_time_field == name) {
       error = "point_time_field: '" + point_time_field + "' clashes with a written point field";

@@ -16,6 +16,7 @@
 #include "src/io/custom_msg.h"
 #include "src/io/custom_msg_codec.h"
 #include "src/io/imu_codec.h"
+#include "src/io/message_types.h"
 #include "src/io/odometry_msg.h"
 #include "src/io/point_time_check.h"
 #include "src/io/pointcloud2_codec.h"
@@ -28,12 +29,9 @@ namespace {
 
 using internal::AllFinite;
 using internal::DropNonFinitePoints;
-using internal::IsCustomMsgType;
-using internal::kLivoxCustomMsgMd5;
+using internal::MessageKind;
+using internal::WireEncoding;
 
-constexpr char kImuType[] = "sensor_msgs/Imu";
-constexpr char kPointCloud2Type[] = "sensor_msgs/PointCloud2";
-constexpr char kPoseStampedType[] = "geometry_msgs/PoseStamped";
 // LiDAR messages whose bag times give the scan period.
 constexpr size_t kScanPeriodSamples = 1001;
 
@@ -51,29 +49,38 @@ const char* OptionKey(StreamKind kind) {
   return "?";
 }
 
-// The message types a stream accepts, for messages.
-const char* AcceptedTypes(StreamKind kind) {
+// The message types a stream accepts, for messages: ROS1 names, or for a
+// log of ROS 2 (CDR) messages the ROS 2 names.
+const char* AcceptedTypes(StreamKind kind, bool ros2) {
   switch (kind) {
     case StreamKind::kImu:
-      return "sensor_msgs/Imu";
+      return ros2 ? "sensor_msgs/msg/Imu" : "sensor_msgs/Imu";
     case StreamKind::kLidar:
-      return "sensor_msgs/PointCloud2 or livox_ros_driver(2)/CustomMsg";
+      return ros2 ? "sensor_msgs/msg/PointCloud2 or livox_ros_driver2/msg/CustomMsg"
+                  : "sensor_msgs/PointCloud2 or livox_ros_driver(2)/CustomMsg";
     case StreamKind::kGroundTruth:
-      return "geometry_msgs/PoseStamped or nav_msgs/Odometry";
+      return ros2 ? "geometry_msgs/msg/PoseStamped or nav_msgs/msg/Odometry"
+                  : "geometry_msgs/PoseStamped or nav_msgs/Odometry";
   }
   return "?";
 }
 
-bool TypeMatches(StreamKind kind, const std::string& datatype) {
+StreamKind StreamOf(MessageKind kind) {
   switch (kind) {
-    case StreamKind::kImu:
-      return datatype == kImuType;
-    case StreamKind::kLidar:
-      return datatype == kPointCloud2Type || IsCustomMsgType(datatype);
-    case StreamKind::kGroundTruth:
-      return datatype == kPoseStampedType || datatype == internal::kNavOdometryDataType;
+    case MessageKind::kImu:
+      return StreamKind::kImu;
+    case MessageKind::kPointCloud2:
+    case MessageKind::kLivoxCustomMsg:
+      return StreamKind::kLidar;
+    default:
+      return StreamKind::kGroundTruth;
   }
-  return false;
+}
+
+bool TypeMatches(StreamKind kind, const internal::SourceConnection& c) {
+  WireEncoding wire = WireEncoding::kRos1;
+  const MessageKind message = internal::MessageKindOf(c.datatype, c.encoding, &wire);
+  return message != MessageKind::kUnsupported && StreamOf(message) == kind;
 }
 
 }  // namespace
@@ -131,6 +138,13 @@ class BagReader::Impl {
   // Decodes and checks one message; sets stream->pending when the record is
   // delivered, leaves it empty when skipped.
   Status Consume(TopicStream* stream, const internal::SourceMessage& message);
+  // True when the log holds ROS 2 (CDR) messages (for the type names in errors).
+  bool Ros2Log() const {
+    for (const internal::SourceConnection& c : source_->connections()) {
+      if (c.encoding == internal::kCdrEncoding) return true;
+    }
+    return false;
+  }
   // True when scans without a per-point time field get it from azimuth.
   bool ReconstructFromAzimuth() const {
     return options_.reconstruct_point_time == PointTimeReconstruction::kAzimuth ||
@@ -153,6 +167,7 @@ class BagReader::Impl {
   std::string ground_truth_topic_;
   LidarMessageType lidar_type_ = LidarMessageType::kPointCloud2;
   GroundTruthMessageType ground_truth_type_ = GroundTruthMessageType::kPoseStamped;
+  std::array<WireEncoding, 3> encodings_{};  // by StreamKind
   double scan_period_s_ = internal::kDefaultScanPeriodS;
   bool scan_period_measured_ = false;
   ReadStats stats_;
@@ -183,7 +198,7 @@ Status BagReader::Impl::ResolveTopic(StreamKind kind,
   }
   std::map<std::string, std::string> candidates;  // topic -> datatype
   for (const internal::SourceConnection& c : connections) {
-    if (TypeMatches(kind, c.datatype)) candidates.emplace(c.topic, c.datatype);
+    if (TypeMatches(kind, c)) candidates.emplace(c.topic, c.datatype);
   }
   const std::string what = is_auto ? key + " is '" + configured + "' (find by type)"
                                    : key + " '" + configured + "' not found";
@@ -199,7 +214,7 @@ Status BagReader::Impl::ResolveTopic(StreamKind kind,
   if (candidates.empty()) {
     if (ground_truth) return Status::Ok();
     return Status::NotFound("bag '" + path_ + "': " + what + ", and no topic has type " +
-                            AcceptedTypes(kind) +
+                            AcceptedTypes(kind, Ros2Log()) +
                             "; the bag has topics: " + internal::DescribeTopics(connections));
   }
   std::string list;
@@ -208,64 +223,42 @@ Status BagReader::Impl::ResolveTopic(StreamKind kind,
   }
   return Status::NotFound("bag '" + path_ + "': " + what + ", and " +
                           std::to_string(candidates.size()) + " topics have type " +
-                          AcceptedTypes(kind) + ": " + list + "; set " + key + " to one of them");
+                          AcceptedTypes(kind, Ros2Log()) + ": " + list + "; set " + key +
+                          " to one of them");
 }
 
 Status BagReader::Impl::CheckTopic(StreamKind kind, const std::string& topic) {
-  const std::string key = OptionKey(kind);
-  std::string type_found;
+  const std::string where = "bag '" + path_ + "': " + OptionKey(kind) + " '" + topic + "'";
+  bool found = false;
+  MessageKind first = MessageKind::kUnsupported;
+  WireEncoding first_wire = WireEncoding::kRos1;
   for (const internal::SourceConnection& c : source_->connections()) {
     if (c.topic != topic) continue;
-    bool type_ok = false;
-    bool md5_ok = false;
-    if (kind == StreamKind::kImu) {
-      type_ok = c.datatype == kImuType;
-      md5_ok = c.md5sum == ros::message_traits::MD5Sum<sensor_msgs::Imu>::value();
-    } else if (kind == StreamKind::kGroundTruth) {
-      GroundTruthMessageType type = GroundTruthMessageType::kPoseStamped;
-      if (c.datatype == kPoseStampedType) {
-        type_ok = true;
-        md5_ok = c.md5sum == ros::message_traits::MD5Sum<geometry_msgs::PoseStamped>::value();
-      } else if (c.datatype == internal::kNavOdometryDataType) {
-        type_ok = true;
-        type = GroundTruthMessageType::kOdometry;
-        md5_ok = c.md5sum == internal::kNavOdometryMd5;
-      }
-      if (type_ok) {
-        if (!type_found.empty() && type != ground_truth_type_) {
-          return Status::InvalidArgument("bag '" + path_ + "': " + key + " '" + topic +
-                                         "' carries several message types");
-        }
-        ground_truth_type_ = type;
-      }
-    } else {
-      LidarMessageType type = LidarMessageType::kPointCloud2;
-      if (c.datatype == kPointCloud2Type) {
-        type_ok = true;
-        md5_ok = c.md5sum == ros::message_traits::MD5Sum<sensor_msgs::PointCloud2>::value();
-      } else if (IsCustomMsgType(c.datatype)) {
-        type_ok = true;
-        type = LidarMessageType::kLivoxCustomMsg;
-        md5_ok = c.md5sum == kLivoxCustomMsgMd5;
-      }
-      if (type_ok) {
-        if (!type_found.empty() && type != lidar_type_) {
-          return Status::InvalidArgument("bag '" + path_ + "': " + key + " '" + topic +
-                                         "' carries several message types");
-        }
-        lidar_type_ = type;
-      }
+    WireEncoding wire = WireEncoding::kRos1;
+    const MessageKind message = internal::MessageKindOf(c.datatype, c.encoding, &wire);
+    if (message == MessageKind::kUnsupported || StreamOf(message) != kind) {
+      const std::string encoding =
+          c.encoding == internal::kRos1Encoding ? "" : " (encoding " + c.encoding + ")";
+      return Status::InvalidArgument(where + " has type " + c.datatype + encoding + ", expected " +
+                                     AcceptedTypes(kind, Ros2Log()));
     }
-    if (!type_ok) {
-      return Status::InvalidArgument("bag '" + path_ + "': " + key + " '" + topic + "' has type " +
-                                     c.datatype + ", expected " + AcceptedTypes(kind));
-    }
-    if (!md5_ok) {
-      return Status::InvalidArgument("bag '" + path_ + "': " + key + " '" + topic + "' type " +
-                                     c.datatype + " has MD5 " + c.md5sum +
+    if (wire == WireEncoding::kRos1 && c.md5sum != internal::ExpectedRos1Md5(message)) {
+      return Status::InvalidArgument(where + " type " + c.datatype + " has MD5 " + c.md5sum +
                                      ", which does not match the supported definition");
     }
-    type_found = c.datatype;
+    if (found && (message != first || wire != first_wire)) {
+      return Status::InvalidArgument(where + " carries several message types");
+    }
+    found = true;
+    first = message;
+    first_wire = wire;
+  }
+  encodings_[static_cast<size_t>(kind)] = first_wire;
+  if (first == MessageKind::kLivoxCustomMsg) lidar_type_ = LidarMessageType::kLivoxCustomMsg;
+  if (first == MessageKind::kPointCloud2) lidar_type_ = LidarMessageType::kPointCloud2;
+  if (first == MessageKind::kOdometry) ground_truth_type_ = GroundTruthMessageType::kOdometry;
+  if (first == MessageKind::kPoseStamped) {
+    ground_truth_type_ = GroundTruthMessageType::kPoseStamped;
   }
   return Status::Ok();
 }
@@ -363,11 +356,12 @@ Status BagReader::Impl::Consume(TopicStream* stream, const internal::SourceMessa
   }
   const uint8_t* data = message.data;
   const size_t size = message.size;
+  const WireEncoding wire = encodings_[static_cast<size_t>(stream->kind)];
 
   switch (stream->kind) {
     case StreamKind::kImu: {
       ImuSample imu;
-      const Status status = internal::DecodeImu(data, size, &imu);
+      const Status status = internal::DecodeImu(data, size, &imu, wire);
       if (!status.ok()) return Malformed(*stream, message, status);
       if (!AllFinite(imu.angular_velocity_rad_s) || !AllFinite(imu.linear_acceleration)) {
         Skip(SkipReason::kImuNonFinite, *stream);
@@ -383,13 +377,13 @@ Status BagReader::Impl::Consume(TopicStream* stream, const internal::SourceMessa
       std::string time_field;
       Status status;
       if (lidar_type_ == LidarMessageType::kLivoxCustomMsg) {
-        status = internal::DecodeLivoxCustomMsg(data, size, &scan);
+        status = internal::DecodeLivoxCustomMsg(data, size, &scan, wire);
       } else {
         internal::PointCloud2DecodeOptions decode_options;
         decode_options.time_unit = options_.point_time_unit;
         decode_options.time_field = options_.point_time_field;
         internal::PointCloud2DecodeInfo info;
-        status = internal::DecodePointCloud2(data, size, decode_options, &scan, &info);
+        status = internal::DecodePointCloud2(data, size, decode_options, &scan, &info, wire);
         without_point_time = status.ok() && !info.has_time_field;
         time_field = info.time_field;
       }
@@ -435,8 +429,8 @@ Status BagReader::Impl::Consume(TopicStream* stream, const internal::SourceMessa
     case StreamKind::kGroundTruth: {
       PoseStamped pose;
       const Status status = ground_truth_type_ == GroundTruthMessageType::kOdometry
-                                ? internal::DecodeOdometryPose(data, size, &pose)
-                                : internal::DecodePoseStamped(data, size, &pose);
+                                ? internal::DecodeOdometryPose(data, size, &pose, wire)
+                                : internal::DecodePoseStamped(data, size, &pose, wire);
       if (!status.ok()) return Malformed(*stream, message, status);
       if (!pose.p_b_in_G.allFinite() || !pose.q_G_b.coeffs().allFinite()) {
         Skip(SkipReason::kPoseNonFinite, *stream);

@@ -6,13 +6,17 @@
 #include <rosbag/view.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 #include <utility>
 
 #include "src/io/bag_common.h"
 #include "src/io/bag_precheck.h"
 #include "src/io/bag_recovery.h"
+#include "src/io/db3_source.h"
+#include "src/io/mcap_source.h"
 #include "src/io/ros_time.h"
+#include "src/io/rosbag2_folder.h"
 #include "swarmlio/common/check.h"
 
 namespace swarmlio::io::internal {
@@ -259,6 +263,12 @@ Status BagSource::Open(const std::string& path,
                        std::unique_ptr<BagSource>* source) {
   CHECK(source != nullptr);
   source->reset();
+  // The format is told by the magic bytes, whatever the extension; a folder
+  // is a rosbag2 recording.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return OpenRosbag2Folder(path, options, source);
+  if (HasMcapMagic(path)) return OpenMcapSource(path, options, source);
+  if (HasSqliteMagic(path)) return OpenDb3Source(path, source);
   auto healthy = std::make_unique<RosbagSource>(path);
   BagPrecheckResult precheck;
   const Status opened = OpenBagForReading(path, options.verify_chunks, healthy->bag(), &precheck);

@@ -1,7 +1,9 @@
 // Where the bag reader and ReadBagInfo get messages from: rosbag's index for
-// a healthy bag, or a scan of the records (bag_recovery.h) for a truncated
-// or unindexed one. Both give the connections, the time range, and per topic
-// the messages in bag-time order, as raw bytes.
+// a healthy ROS1 bag, a scan of the records (bag_recovery.h) for a truncated
+// or unindexed one, a scan of an MCAP file (mcap_source.h), a rosbag2 SQLite3
+// file (db3_source.h) -- each told by its magic bytes, not its extension --
+// or a rosbag2 folder of such files (rosbag2_folder.h). Both give the connections, the time range,
+// and per topic the messages in bag-time order, as raw bytes.
 #pragma once
 
 #include <cstddef>
@@ -17,8 +19,9 @@ namespace swarmlio::io::internal {
 
 struct SourceConnection {
   std::string topic;
-  std::string datatype;
-  std::string md5sum;
+  std::string datatype;           // ROS1 ("sensor_msgs/Imu") or ROS 2 ("sensor_msgs/msg/Imu") name
+  std::string md5sum;             // ROS1 only
+  std::string encoding = "ros1";  // message encoding: "ros1", or an MCAP channel's ("cdr")
 };
 
 /// One stored message. `data` stays valid until the stream's next call.

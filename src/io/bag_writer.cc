@@ -6,13 +6,18 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include <exception>
+#include <limits>
+#include <map>
 #include <string>
 #include <utility>
 
 #include "src/io/bag_common.h"
+#include "src/io/cdr_serialize.h"
 #include "src/io/custom_msg.h"
 #include "src/io/custom_msg_codec.h"
 #include "src/io/imu_codec.h"
+#include "src/io/mcap_writer.h"
+#include "src/io/message_types.h"
 #include "src/io/pointcloud2_codec.h"
 #include "src/io/pose_codec.h"
 #include "src/io/ros_time.h"
@@ -29,8 +34,30 @@ rosbag::CompressionType ToRosbag(BagCompression compression) {
       return rosbag::compression::LZ4;
     case BagCompression::kBz2:
       return rosbag::compression::BZ2;
+    case BagCompression::kZstd:
+      break;  // refused by CheckCompressionFor
   }
   return rosbag::compression::Uncompressed;
+}
+
+std::string McapCompression(BagCompression compression) {
+  switch (compression) {
+    case BagCompression::kLz4:
+      return "lz4";
+    case BagCompression::kZstd:
+      return "zstd";
+    default:
+      return "";
+  }
+}
+
+// The ROS 2 stamp's int32 seconds must hold the stamp (ROS1 allows 2^32 s).
+Status CheckRos2Stamp(const ros::Time& stamp) {
+  if (stamp.sec > static_cast<uint32_t>(std::numeric_limits<int32_t>::max())) {
+    return Status::InvalidArgument("stamp " + std::to_string(stamp.sec) +
+                                   " s does not fit a ROS 2 int32 stamp");
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -45,8 +72,18 @@ class BagWriter::Impl {
   }
 
   Status Open() {
-    const std::string error = options_.Validate();
+    std::string error = options_.Validate();
+    const BagFormat format = ResolveBagFormat(options_.format, path_);
+    if (error.empty()) error = CheckCompressionFor(format, options_.compression);
     if (!error.empty()) return Status::InvalidArgument("BagWriterOptions: " + error);
+    if (format == BagFormat::kMcap) {
+      internal::McapWriterOptions mcap_options;
+      mcap_options.compression = McapCompression(options_.compression);
+      mcap_ = std::make_unique<internal::McapWriter>();
+      SWARMLIO_RETURN_IF_ERROR(mcap_->Open(path_, mcap_options));
+      open_ = true;
+      return Status::Ok();
+    }
     internal::RouteRosbagLogsToGlog();
     try {
       bag_.open(path_, rosbag::bagmode::Write);
@@ -64,7 +101,8 @@ class BagWriter::Impl {
     sensor_msgs::Imu msg;
     SWARMLIO_RETURN_IF_ERROR(
         internal::EncodeImu(imu, imu_seq_, &msg).WithContext("bag '" + path_ + "': IMU"));
-    SWARMLIO_RETURN_IF_ERROR(Write(options_.imu_topic, record_time_ns, msg));
+    SWARMLIO_RETURN_IF_ERROR(
+        Write(options_.imu_topic, internal::MessageKind::kImu, record_time_ns, msg));
     ++imu_seq_;
     return Status::Ok();
   }
@@ -75,7 +113,8 @@ class BagWriter::Impl {
       internal::LivoxCustomMsg msg;
       SWARMLIO_RETURN_IF_ERROR(
           internal::EncodeLivoxCustomMsg(scan, scan_seq_, &msg).WithContext(context));
-      SWARMLIO_RETURN_IF_ERROR(Write(options_.lidar_topic, record_time_ns, msg));
+      SWARMLIO_RETURN_IF_ERROR(
+          Write(options_.lidar_topic, internal::MessageKind::kLivoxCustomMsg, record_time_ns, msg));
     } else {
       sensor_msgs::PointCloud2 msg;
       SWARMLIO_RETURN_IF_ERROR(internal::EncodePointCloud2(scan, scan_seq_,
@@ -85,7 +124,8 @@ class BagWriter::Impl {
                                                                : std::string(),
                                                            &msg)
                                    .WithContext(context));
-      SWARMLIO_RETURN_IF_ERROR(Write(options_.lidar_topic, record_time_ns, msg));
+      SWARMLIO_RETURN_IF_ERROR(
+          Write(options_.lidar_topic, internal::MessageKind::kPointCloud2, record_time_ns, msg));
     }
     ++scan_seq_;
     return Status::Ok();
@@ -97,12 +137,14 @@ class BagWriter::Impl {
       internal::NavOdometry msg;
       SWARMLIO_RETURN_IF_ERROR(
           internal::EncodeOdometry(pose, pose_seq_, &msg).WithContext(context));
-      SWARMLIO_RETURN_IF_ERROR(Write(options_.ground_truth_topic, record_time_ns, msg));
+      SWARMLIO_RETURN_IF_ERROR(Write(options_.ground_truth_topic, internal::MessageKind::kOdometry,
+                                     record_time_ns, msg));
     } else {
       geometry_msgs::PoseStamped msg;
       SWARMLIO_RETURN_IF_ERROR(
           internal::EncodePoseStamped(pose, pose_seq_, &msg).WithContext(context));
-      SWARMLIO_RETURN_IF_ERROR(Write(options_.ground_truth_topic, record_time_ns, msg));
+      SWARMLIO_RETURN_IF_ERROR(Write(options_.ground_truth_topic,
+                                     internal::MessageKind::kPoseStamped, record_time_ns, msg));
     }
     ++pose_seq_;
     return Status::Ok();
@@ -111,6 +153,7 @@ class BagWriter::Impl {
   Status Close() {
     if (!open_) return Status::Ok();
     open_ = false;
+    if (mcap_ != nullptr) return mcap_->Close();
     try {
       bag_.close();
     } catch (const std::exception& e) {
@@ -124,9 +167,49 @@ class BagWriter::Impl {
   const std::string& path() const { return path_; }
 
  private:
+  // MCAP: the topic's channel (and its type's schema) on first use.
+  Status McapChannel(const std::string& topic, internal::MessageKind kind, uint16_t* channel) {
+    const auto found = mcap_channels_.find(topic);
+    if (found != mcap_channels_.end()) {
+      *channel = found->second;
+      return Status::Ok();
+    }
+    auto schema = mcap_schemas_.find(kind);
+    if (schema == mcap_schemas_.end()) {
+      uint16_t id = 0;
+      SWARMLIO_RETURN_IF_ERROR(mcap_->AddSchema(internal::Ros2TypeName(kind), "ros2msg",
+                                                internal::Ros2SchemaText(kind), &id));
+      schema = mcap_schemas_.emplace(kind, id).first;
+    }
+    SWARMLIO_RETURN_IF_ERROR(
+        mcap_->AddChannel(schema->second, topic, internal::kCdrEncoding, channel));
+    mcap_channels_[topic] = *channel;
+    return Status::Ok();
+  }
+
   template <class Msg>
-  Status Write(const std::string& topic, int64_t record_time_ns, const Msg& msg) {
+  Status WriteMcap(const std::string& topic,
+                   internal::MessageKind kind,
+                   int64_t record_time_ns,
+                   const Msg& msg) {
+    if (record_time_ns < 0) {
+      return Status::InvalidArgument("bag '" + path_ + "': record time " +
+                                     std::to_string(record_time_ns) + " ns is negative");
+    }
+    SWARMLIO_RETURN_IF_ERROR(CheckRos2Stamp(msg.header.stamp).WithContext("bag '" + path_ + "'"));
+    uint16_t channel = 0;
+    SWARMLIO_RETURN_IF_ERROR(McapChannel(topic, kind, &channel));
+    internal::SerializeCdr(msg, &buffer_);
+    return mcap_->WriteMessage(channel, static_cast<uint64_t>(record_time_ns), buffer_);
+  }
+
+  template <class Msg>
+  Status Write(const std::string& topic,
+               internal::MessageKind kind,
+               int64_t record_time_ns,
+               const Msg& msg) {
     if (!open_) return Status::FailedPrecondition("bag '" + path_ + "': writer is closed");
+    if (mcap_ != nullptr) return WriteMcap(topic, kind, record_time_ns, msg);
     ros::Time time;
     SWARMLIO_RETURN_IF_ERROR(internal::BagTimeFromStampNs(record_time_ns, &time)
                                  .WithContext("bag '" + path_ + "': record time"));
@@ -143,6 +226,10 @@ class BagWriter::Impl {
   std::string path_;
   BagWriterOptions options_;
   rosbag::Bag bag_;
+  std::unique_ptr<internal::McapWriter> mcap_;  // set when writing MCAP instead of ROS1
+  std::map<std::string, uint16_t> mcap_channels_;
+  std::map<internal::MessageKind, uint16_t> mcap_schemas_;
+  std::vector<uint8_t> buffer_;
   bool open_ = false;
   uint32_t imu_seq_ = 0;
   uint32_t scan_seq_ = 0;

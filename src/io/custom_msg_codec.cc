@@ -21,8 +21,12 @@ uint8_t ReflectivityToByte(float reflectivity) {
 
 }  // namespace
 
-Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, LidarScan* scan) {
+Status DecodeLivoxCustomMsg(const uint8_t* data,
+                            size_t size,
+                            LidarScan* scan,
+                            WireEncoding encoding) {
   RosMessageReader reader(data, size);
+  SWARMLIO_RETURN_IF_ERROR(reader.Begin(encoding));
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &scan->stamp_ns, &scan->frame_id));
   uint32_t point_num = 0;
   SWARMLIO_RETURN_IF_ERROR(reader.ReadU64("timebase", &scan->livox_timebase_ns));
@@ -36,13 +40,19 @@ Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, LidarScan* scan) {
     return Status::DataLoss("livox CustomMsg: point_num " + std::to_string(point_num) +
                             " != points array length " + std::to_string(count));
   }
+  // CDR aligns each point to its uint32 offset_time: 19 bytes + 1 padding
+  // between points (the array itself starts aligned, after its count).
+  const size_t stride =
+      encoding == WireEncoding::kCdr ? kLivoxCustomPointBytes + 1 : kLivoxCustomPointBytes;
+  const size_t points_bytes =
+      count == 0 ? 0 : (static_cast<size_t>(count) - 1) * stride + kLivoxCustomPointBytes;
   const uint8_t* bytes = nullptr;
-  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("points", count * kLivoxCustomPointBytes, &bytes));
+  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("points", points_bytes, &bytes));
   SWARMLIO_RETURN_IF_ERROR(reader.ExpectEnd(kLivoxCustomMsgDataType));
 
   scan->points.resize(count);
   for (uint32_t i = 0; i < count; ++i) {
-    const uint8_t* p = bytes + static_cast<size_t>(i) * kLivoxCustomPointBytes;
+    const uint8_t* p = bytes + static_cast<size_t>(i) * stride;
     LidarPoint& point = scan->points[i];
     point.offset_time_s = static_cast<double>(LoadLittleEndian<uint32_t>(p)) / kNsPerS;
     point.x = LoadFloat32(p + 4);

@@ -12,23 +12,18 @@ Status ReadVector3(RosMessageReader* reader, const char* field, Eigen::Vector3d*
   return Status::Ok();
 }
 
-// Skips a fixed-size float64 array of `count` elements.
-Status SkipFloat64s(RosMessageReader* reader, const char* field, size_t count) {
-  const uint8_t* unused = nullptr;
-  return reader->ReadBytes(field, count * 8, &unused);
-}
-
 }  // namespace
 
-Status DecodeImu(const uint8_t* data, size_t size, ImuSample* imu) {
+Status DecodeImu(const uint8_t* data, size_t size, ImuSample* imu, WireEncoding encoding) {
   RosMessageReader reader(data, size);
+  SWARMLIO_RETURN_IF_ERROR(reader.Begin(encoding));
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &imu->stamp_ns, &imu->frame_id));
-  SWARMLIO_RETURN_IF_ERROR(SkipFloat64s(&reader, "orientation", 4));
-  SWARMLIO_RETURN_IF_ERROR(SkipFloat64s(&reader, "orientation_covariance", 9));
+  SWARMLIO_RETURN_IF_ERROR(reader.SkipF64s("orientation", 4));
+  SWARMLIO_RETURN_IF_ERROR(reader.SkipF64s("orientation_covariance", 9));
   SWARMLIO_RETURN_IF_ERROR(ReadVector3(&reader, "angular_velocity", &imu->angular_velocity_rad_s));
-  SWARMLIO_RETURN_IF_ERROR(SkipFloat64s(&reader, "angular_velocity_covariance", 9));
+  SWARMLIO_RETURN_IF_ERROR(reader.SkipF64s("angular_velocity_covariance", 9));
   SWARMLIO_RETURN_IF_ERROR(ReadVector3(&reader, "linear_acceleration", &imu->linear_acceleration));
-  SWARMLIO_RETURN_IF_ERROR(SkipFloat64s(&reader, "linear_acceleration_covariance", 9));
+  SWARMLIO_RETURN_IF_ERROR(reader.SkipF64s("linear_acceleration_covariance", 9));
   return reader.ExpectEnd("sensor_msgs/Imu");
 }
 

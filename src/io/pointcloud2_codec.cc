@@ -165,8 +165,10 @@ Status DecodePointCloud2(const uint8_t* data,
                          size_t size,
                          const PointCloud2DecodeOptions& options,
                          LidarScan* scan,
-                         PointCloud2DecodeInfo* info) {
+                         PointCloud2DecodeInfo* info,
+                         WireEncoding encoding) {
   RosMessageReader reader(data, size);
+  SWARMLIO_RETURN_IF_ERROR(reader.Begin(encoding));
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &scan->stamp_ns, &scan->frame_id));
   scan->livox_timebase_ns = 0;
   scan->livox_lidar_id = 0;

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <string>
 
+#include "src/io/ros_message_reader.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/io/bag_options.h"
 #include "swarmlio/sensors/measurements.h"
@@ -30,13 +31,15 @@ struct PointCloud2DecodeInfo {
   std::string time_field;  // the field used (empty if none)
 };
 
-/// Decodes the serialized bytes of one PointCloud2. Points are returned as
+/// Decodes the serialized bytes of one PointCloud2 (ROS1, or ROS 2 CDR for
+/// sensor_msgs/msg/PointCloud2). Points are returned as
 /// stored (NaN included). A configured time field that is absent is an error.
 Status DecodePointCloud2(const uint8_t* data,
                          size_t size,
                          const PointCloud2DecodeOptions& options,
                          LidarScan* scan,
-                         PointCloud2DecodeInfo* info);
+                         PointCloud2DecodeInfo* info,
+                         WireEncoding encoding = WireEncoding::kRos1);
 
 /// Fills an unorganized (height 1) cloud with 32-byte points: x y z
 /// intensity (FLOAT32 at 0 4 8 12), `time_field` (FLOAT64 at 16, offset in

@@ -10,9 +10,9 @@ namespace swarmlio::io::internal {
 namespace {
 
 // float64[36] covariance of PoseWithCovariance / TwistWithCovariance.
-constexpr size_t kCovarianceBytes = 36 * 8;
+constexpr size_t kCovarianceValues = 36;
 // Twist: linear and angular float64 x y z.
-constexpr size_t kTwistBytes = 6 * 8;
+constexpr size_t kTwistValues = 6;
 
 // geometry_msgs/Pose: position x y z, orientation x y z w.
 Status ReadPose(RosMessageReader* reader,
@@ -31,23 +31,30 @@ Status ReadPose(RosMessageReader* reader,
 
 }  // namespace
 
-Status DecodePoseStamped(const uint8_t* data, size_t size, PoseStamped* pose) {
+Status DecodePoseStamped(const uint8_t* data,
+                         size_t size,
+                         PoseStamped* pose,
+                         WireEncoding encoding) {
   RosMessageReader reader(data, size);
+  SWARMLIO_RETURN_IF_ERROR(reader.Begin(encoding));
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &pose->stamp_ns, &pose->frame_id));
   SWARMLIO_RETURN_IF_ERROR(ReadPose(&reader, "pose.position", "pose.orientation", pose));
   return reader.ExpectEnd("geometry_msgs/PoseStamped");
 }
 
-Status DecodeOdometryPose(const uint8_t* data, size_t size, PoseStamped* pose) {
+Status DecodeOdometryPose(const uint8_t* data,
+                          size_t size,
+                          PoseStamped* pose,
+                          WireEncoding encoding) {
   RosMessageReader reader(data, size);
+  SWARMLIO_RETURN_IF_ERROR(reader.Begin(encoding));
   SWARMLIO_RETURN_IF_ERROR(ReadRosHeader(&reader, &pose->stamp_ns, &pose->frame_id));
   std::string child_frame_id;
   SWARMLIO_RETURN_IF_ERROR(reader.ReadString("child_frame_id", &child_frame_id));
   SWARMLIO_RETURN_IF_ERROR(ReadPose(&reader, "pose.pose.position", "pose.pose.orientation", pose));
-  const uint8_t* skipped = nullptr;
-  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("pose.covariance", kCovarianceBytes, &skipped));
-  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("twist.twist", kTwistBytes, &skipped));
-  SWARMLIO_RETURN_IF_ERROR(reader.ReadBytes("twist.covariance", kCovarianceBytes, &skipped));
+  SWARMLIO_RETURN_IF_ERROR(reader.SkipF64s("pose.covariance", kCovarianceValues));
+  SWARMLIO_RETURN_IF_ERROR(reader.SkipF64s("twist.twist", kTwistValues));
+  SWARMLIO_RETURN_IF_ERROR(reader.SkipF64s("twist.covariance", kCovarianceValues));
   return reader.ExpectEnd(kNavOdometryDataType);
 }
 

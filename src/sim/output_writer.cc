@@ -123,7 +123,7 @@ std::string ReplayManifestYaml(const Scenario& s, const Simulator& sim) {
     lidar.R_imu_lidar = given.R_imu_lidar;
     lidar.p_lidar_in_imu_m = given.p_lidar_in_imu_m;
     os << "  - name: " << d.name << "\n";
-    os << "    bag: " << d.name << ".bag\n";
+    os << "    bag: " << BagFileName(d.name, s.bag) << "\n";
     os << "    # G_i in the simulation world W (for plots)\n";
     os << "    p_G_in_W_m: " << Vec(T.p_b_in_W) << "\n";
     os << "    q_W_G_xyzw: " << Quat(Eigen::Quaterniond(T.R_W_b)) << "\n";
@@ -147,6 +147,10 @@ io::BagWriterOptions BagOptionsFor(const io::BagWriterOptions& base, const Lidar
   options.lidar_format = lidar.message_format;
   options.point_time_unit = lidar.timestamp_unit;
   return options;
+}
+
+std::string BagFileName(const std::string& name, const io::BagWriterOptions& options) {
+  return name + (options.format == io::BagFormat::kMcap ? ".mcap" : ".bag");
 }
 
 Status DroneOutputWriter::Open(const std::string& bag_path, const std::string& tum_path,

@@ -3,11 +3,13 @@
 // (accelerometer sign flipped by the driver, PointCloud2 without per-point
 // time, other topic names with ground truth in another frame) and each must
 // track about as well as the original (position RMSE within 2x). No manifest
-// topics are set: the reader finds them by type.
+// topics are set: the reader finds them by type. The same flight simulated
+// into an MCAP file (ROS 2 messages) must give the very same trajectory.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -39,7 +41,11 @@ struct SimDrone {
   double imu_time_offset_s = 0.0;
 };
 
-Status Simulate(const fs::path& dir, const std::string& name, bool spinning, SimDrone* out) {
+Status Simulate(const fs::path& dir,
+                const std::string& name,
+                bool spinning,
+                SimDrone* out,
+                io::BagFormat format = io::BagFormat::kRos1) {
   sim::Scenario scenario;
   SWARMLIO_RETURN_IF_ERROR(sim::LoadScenario(
       std::string(SWARMLIO_SOURCE_DIR) + "/configs/scenarios/indoor_3uav.yaml", &scenario));
@@ -55,7 +61,8 @@ Status Simulate(const fs::path& dir, const std::string& name, bool spinning, Sim
         &unused_imu));
     drone.lidar.sensor.points_per_second = 192000;  // 0.6 deg azimuth steps: a faster test
   }
-  out->bag = (dir / (name + ".bag")).string();
+  scenario.bag.format = format;
+  out->bag = (dir / sim::BagFileName(name, scenario.bag)).string();
   out->lidar = drone.lidar.sensor;
   out->imu = drone.imu.sensor;
   out->imu_time_offset_s = drone.imu.time_offset_s;
@@ -109,6 +116,7 @@ Status Rewrite(const std::string& in, const std::string& out, const io::BagWrite
 
 struct RunResult {
   double rmse_m = 0.0;  // vs the original ground truth (in G)
+  eval::Trajectory estimate;
   eval::FrameCheck frame;
   lio::ImuInitialization init;
   io::ReadStats stats;
@@ -193,6 +201,7 @@ class ForeignBagTest : public ::testing::Test {
                                           eval::TrajectoryFromPoses(truth), 0.05, &cs)
                     .ok());
     result.rmse_m = cs.position_rmse_m;
+    result.estimate = UpdatedEstimate(d.scans()).poses;
     if (!d.bag_ground_truth().empty()) {
       EXPECT_TRUE(eval::CheckGroundTruthFrame(UpdatedEstimate(d.scans()).poses,
                                               eval::TrajectoryFromPoses(d.bag_ground_truth()),
@@ -290,6 +299,29 @@ TEST_F(ForeignBagTest, SpinningCloudWithoutPointTimeTracksLikeTheOriginal) {
   EXPECT_LT(timed.rmse_m, 0.05);
   EXPECT_LT(reconstructed.rmse_m, 2.0 * timed.rmse_m);
   EXPECT_LT(reconstructed.rmse_m, instant.rmse_m);
+}
+
+// The same flight simulated into a ROS1 bag and into an MCAP file of ROS 2
+// CDR messages: replayed, the trajectories are the same to 1e-9 m.
+TEST_F(ForeignBagTest, SameFlightFromMcapGivesTheSameTrajectory) {
+  SimDrone mcap;
+  ASSERT_TRUE(Simulate(*dir_, "mid360_ros2", false, &mcap, io::BagFormat::kMcap).ok());
+  ASSERT_EQ(fs::path(mcap.bag).extension(), ".mcap");
+  const RunResult from_bag = Run(Input(mid360_, mid360_.bag), *truth_mid360_);
+  const RunResult from_mcap = Run(Input(mcap, mcap.bag), *truth_mid360_);
+  EXPECT_EQ(from_mcap.imu_topic, "/livox/imu");
+  EXPECT_EQ(from_mcap.stats.ToString(), from_bag.stats.ToString());
+  ASSERT_GT(from_bag.estimate.size(), 10u);
+  ASSERT_EQ(from_mcap.estimate.size(), from_bag.estimate.size());
+  double max_difference_m = 0.0;
+  for (size_t i = 0; i < from_bag.estimate.size(); ++i) {
+    EXPECT_EQ(from_mcap.estimate.stamps_s[i], from_bag.estimate.stamps_s[i]) << i;
+    max_difference_m = std::max(max_difference_m, (from_mcap.estimate.T_G_b[i].translation() -
+                                                   from_bag.estimate.T_G_b[i].translation())
+                                                      .norm());
+  }
+  EXPECT_LE(max_difference_m, 1e-9);
+  EXPECT_EQ(from_mcap.rmse_m, from_bag.rmse_m);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 # Script mode: runs the simulator tool twice with the same seed (1 and 2
 # worker threads) and requires byte-identical outputs; then reads every bag
-# back with swarmlio_bag_info. EXTRA_ARGS (optional): more simulator flags.
+# back with swarmlio_bag_info (ROS1 bags, or MCAP files with
+# --bag_format=mcap). EXTRA_ARGS (optional): more simulator flags.
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
@@ -14,7 +15,8 @@ foreach(threads 1 2)
 endforeach()
 # The resolved scenario records the thread count, so only the sensor logs and
 # ground truth are compared.
-file(GLOB files RELATIVE ${WORK_DIR}/run1 ${WORK_DIR}/run1/*.bag ${WORK_DIR}/run1/*.txt)
+file(GLOB files RELATIVE ${WORK_DIR}/run1 ${WORK_DIR}/run1/*.bag ${WORK_DIR}/run1/*.mcap
+     ${WORK_DIR}/run1/*.txt)
 list(LENGTH files count)
 if(count LESS 6)
   message(FATAL_ERROR "expected 3 bags and 3 TUM files, got: ${files}")
@@ -26,7 +28,7 @@ foreach(f ${files})
     message(FATAL_ERROR "${f} differs between two runs with the same seed")
   endif()
 endforeach()
-file(GLOB bags ${WORK_DIR}/run1/*.bag)
+file(GLOB bags ${WORK_DIR}/run1/*.bag ${WORK_DIR}/run1/*.mcap)
 foreach(b ${bags})
   run(${BAG_INFO} ${b})
 endforeach()

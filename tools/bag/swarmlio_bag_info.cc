@@ -1,5 +1,7 @@
 // swarmlio_bag_info: prints the topics, message types, counts and time range
-// of a ROS1 bag (of a truncated or unindexed bag: what a scan of its records
+// of a ROS1 bag, an MCAP file or a rosbag2 .db3 file or folder (ROS 2; told
+// by its magic bytes) (of a
+// truncated or unindexed bag: what a scan of its records
 // recovered and what was lost), then reads the IMU / LiDAR / ground-truth
 // topics with BagReader (topics found by type when absent) and prints its
 // statistics (delivered and skipped records).
@@ -65,6 +67,7 @@ int Fail(const std::string& message) {
 
 void PrintInfo(const io::BagInfo& info) {
   std::printf("path:      %s\n", info.path.c_str());
+  std::printf("format:    %s\n", info.format == "ros1" ? "ROS1 bag" : info.format.c_str());
   std::printf("size:      %" PRIu64 " bytes (%.1f MiB)\n", info.file_size_bytes,
               static_cast<double>(info.file_size_bytes) / (1024.0 * 1024.0));
   std::printf("messages:  %" PRId64 "\n", info.message_count);
@@ -77,8 +80,10 @@ void PrintInfo(const io::BagInfo& info) {
   size_t width = 0;
   for (const io::BagTopicInfo& t : info.topics) width = std::max(width, t.topic.size());
   for (const io::BagTopicInfo& t : info.topics) {
+    const std::string type =
+        t.encoding == "ros1" ? t.datatype : t.datatype + " (" + t.encoding + ")";
     std::printf("  %-*s %8" PRId64 " msgs  %s  [%s .. %s s]\n", static_cast<int>(width),
-                t.topic.c_str(), t.message_count, t.datatype.c_str(),
+                t.topic.c_str(), t.message_count, type.c_str(),
                 FormatStamp(t.first_time_ns).c_str(), FormatStamp(t.last_time_ns).c_str());
   }
   if (info.recovery.recovered) {
@@ -91,7 +96,8 @@ void PrintInfo(const io::BagInfo& info) {
 int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "prints topics, types, counts, time range and reader statistics of a "
-      "ROS1 bag\n  usage: swarmlio_bag_info [flags] <bag>");
+      "ROS1 bag, MCAP file, rosbag2 .db3 file or folder\n  usage: swarmlio_bag_info [flags] "
+      "<bag, .mcap, .db3 or rosbag2 folder>");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;

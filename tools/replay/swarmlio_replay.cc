@@ -36,7 +36,10 @@
 #include "swarmlio/replay/swarm_replay.h"
 
 DEFINE_string(manifest, "", "swarm manifest YAML (docs/replay.md); or use --bags");
-DEFINE_string(bags, "", "comma-separated bags, one per drone (instead of --manifest)");
+DEFINE_string(bags,
+              "",
+              "comma-separated logs, one per drone (instead of --manifest): ROS1 bags, MCAP "
+              "files, rosbag2 .db3 files or folders");
 DEFINE_string(names, "", "comma-separated drone names for --bags (default uav1, uav2, ...)");
 DEFINE_string(sensor_preset, "", "sensor preset (configs/*.yaml) for every bag of --bags");
 DEFINE_string(output_dir, "", "results folder (created)");

@@ -1,11 +1,12 @@
 // swarmlio_sim: runs a scenario and writes, per drone, a ROS1 bag
-// (<name>.bag: /livox/lidar, /livox/imu, /ground_truth/pose), a TUM ground
+// (<name>.bag: /livox/lidar, /livox/imu, /ground_truth/pose) or with
+// --bag_format=mcap an MCAP file of ROS 2 messages (<name>.mcap), a TUM ground
 // truth file in the drone's global frame (<name>_gt_tum.txt), and the resolved
 // scenario (resolved_scenario.yaml: T_W_Gi, extrinsics, noise settings) and
 // the replay manifest (swarm.yaml) for swarmlio_replay.
 //
 //   swarmlio_sim --scenario=configs/scenarios/indoor_3uav.yaml --output_dir=out
-//                [--imperfections=realistic]
+//                [--imperfections=realistic] [--bag_format=mcap]
 #include <gflags/gflags.h>
 
 #include <chrono>
@@ -24,6 +25,10 @@
 
 DEFINE_string(scenario, "", "scenario YAML file (configs/scenarios/*.yaml)");
 DEFINE_string(output_dir, "", "output folder (created)");
+DEFINE_string(bag_format,
+              "",
+              "override the scenario's bag.format: ros1 (<name>.bag) or mcap (<name>.mcap, ROS 2 "
+              "CDR messages)");
 DEFINE_double(duration_s, 0.0, "override the scenario duration when > 0");
 DEFINE_int64(seed, -1, "override the scenario seed when >= 0");
 DEFINE_int32(threads, 0, "override the number of worker threads when > 0");
@@ -38,6 +43,16 @@ DEFINE_string(imperfections,
 
 namespace swarmlio::sim {
 namespace {
+
+// --bag_format over the scenario's bag.format; false (printed) if invalid.
+bool ApplyBagFormatFlag(io::BagWriterOptions* bag) {
+  if (FLAGS_bag_format.empty() || config::EnumFromString(FLAGS_bag_format, &bag->format)) {
+    return true;
+  }
+  std::fprintf(stderr, "error: --bag_format '%s' is not one of %s\n", FLAGS_bag_format.c_str(),
+               config::EnumChoices<io::BagFormat>().c_str());
+  return false;
+}
 
 int Main() {
   if (FLAGS_scenario.empty() || FLAGS_output_dir.empty()) {
@@ -62,6 +77,7 @@ int Main() {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());
     return 1;
   }
+  if (!ApplyBagFormatFlag(&scenario.bag)) return 2;
   if (FLAGS_duration_s > 0) scenario.options.duration_s = FLAGS_duration_s;
   if (FLAGS_seed >= 0) scenario.options.seed = FLAGS_seed;
   if (FLAGS_threads > 0) scenario.options.num_threads = FLAGS_threads;
@@ -100,7 +116,7 @@ int Main() {
   for (const DroneConfig& d : scenario.drones) drone_names.push_back(d.name);
   for (const DroneConfig& d : scenario.drones) {
     std::unique_ptr<DroneOutputWriter> w;
-    status = DroneOutputWriter::Open((dir / (d.name + ".bag")).string(),
+    status = DroneOutputWriter::Open((dir / BagFileName(d.name, scenario.bag)).string(),
                                      (dir / (d.name + "_gt_tum.txt")).string(),
                                      BagOptionsFor(scenario.bag, d.lidar.sensor), &w);
     if (status.ok()) {

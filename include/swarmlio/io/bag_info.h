@@ -1,5 +1,7 @@
-// Summary of a ROS1 bag from its index (no message is decoded). A truncated
-// or unindexed bag is summarized from a scan of its records (recovery).
+// Summary of a ROS1 bag from its index, of an MCAP file from a scan of its
+// data section, of a rosbag2 .db3 file or folder from its tables (no message
+// is decoded). A truncated or unindexed bag is
+// summarized from a scan of its records (recovery).
 #pragma once
 
 #include <cstdint>
@@ -13,8 +15,9 @@ namespace swarmlio::io {
 
 struct BagTopicInfo {
   std::string topic;
-  std::string datatype;  // e.g. "sensor_msgs/Imu"
-  std::string md5sum;
+  std::string datatype;  // e.g. "sensor_msgs/Imu" (ROS 2 in MCAP: "sensor_msgs/msg/Imu")
+  std::string md5sum;    // ROS1 only
+  std::string encoding;  // message encoding: "ros1", or an MCAP channel's ("cdr")
   int64_t message_count = 0;
   int64_t first_time_ns = 0;  // bag (receive) time of the first message
   int64_t last_time_ns = 0;   // bag (receive) time of the last message
@@ -22,6 +25,7 @@ struct BagTopicInfo {
 
 struct BagInfo {
   std::string path;
+  std::string format;  // "ros1", "mcap", "db3" (told by the magic bytes) or "rosbag2" (a folder)
   uint64_t file_size_bytes = 0;
   int64_t message_count = 0;
   int64_t start_time_ns = 0;         // bag time of the first message (0 if empty)

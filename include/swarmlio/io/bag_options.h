@@ -13,8 +13,13 @@
 
 namespace swarmlio::io {
 
-/// Chunk compression of a written bag.
-enum class BagCompression { kNone, kLz4, kBz2 };
+/// Chunk compression of a written bag: ROS1 bags take none, lz4 (ROS's own
+/// LZ4 format) and bz2; MCAP files none, lz4 (LZ4 frames) and zstd.
+enum class BagCompression { kNone, kLz4, kBz2, kZstd };
+
+/// Container format of a written bag. kAuto: MCAP when the path ends in
+/// ".mcap", else ROS1.
+enum class BagFormat { kAuto, kRos1, kMcap };
 
 /// Topic option value (or "") that finds the topic by its message type.
 inline constexpr char kAutoTopic[] = "auto";
@@ -109,6 +114,7 @@ struct BagWriterOptions {
   bool write_point_time = true;  // PointCloud2 only; false: no per-point time field (old drivers)
   GroundTruthFormat ground_truth_format = GroundTruthFormat::kPoseStamped;
   BagCompression compression = BagCompression::kNone;
+  BagFormat format = BagFormat::kAuto;
 
   template <class Visitor>
   void VisitFields(Visitor&& v) {
@@ -125,11 +131,22 @@ struct BagWriterOptions {
                              "per-point time, as some drivers publish them)"));
     v("ground_truth_format", ground_truth_format,
       config::FieldSpec::Doc("message type of ground-truth poses"));
-    v("compression", compression, config::FieldSpec::Doc("bag chunk compression"));
+    v("compression", compression,
+      config::FieldSpec::Doc("chunk compression: none, lz4 or bz2 (ROS1), none, lz4 or zstd "
+                             "(MCAP)"));
+    v("format", format,
+      config::FieldSpec::Doc("auto (MCAP for a .mcap path, else ROS1), ros1 or mcap (ROS 2 "
+                             "CDR messages in MCAP)"));
   }
 
   std::string Validate() const;
 };
+
+/// `format`, or for kAuto the format of `path` (MCAP for ".mcap", else ROS1).
+BagFormat ResolveBagFormat(BagFormat format, const std::string& path);
+
+/// "" when `compression` suits `format` (kAuto: any), else the error.
+std::string CheckCompressionFor(BagFormat format, BagCompression compression);
 
 }  // namespace swarmlio::io
 
@@ -154,10 +171,20 @@ struct EnumTraits<io::PointTimeReconstruction> {
 
 template <>
 struct EnumTraits<io::BagCompression> {
-  static constexpr std::array<std::pair<io::BagCompression, const char*>, 3> kNames{{
+  static constexpr std::array<std::pair<io::BagCompression, const char*>, 4> kNames{{
       {io::BagCompression::kNone, "none"},
       {io::BagCompression::kLz4, "lz4"},
       {io::BagCompression::kBz2, "bz2"},
+      {io::BagCompression::kZstd, "zstd"},
+  }};
+};
+
+template <>
+struct EnumTraits<io::BagFormat> {
+  static constexpr std::array<std::pair<io::BagFormat, const char*>, 3> kNames{{
+      {io::BagFormat::kAuto, "auto"},
+      {io::BagFormat::kRos1, "ros1"},
+      {io::BagFormat::kMcap, "mcap"},
   }};
 };
 

@@ -1,5 +1,7 @@
 // Writer of IMU, LiDAR and ground-truth records to a ROS1 bag (format 2.0),
-// readable by the ROS tools (rosbag info/play, rqt_bag) and by BagReader.
+// readable by the ROS tools (rosbag info/play, rqt_bag) and by BagReader, or
+// to an MCAP file of ROS 2 CDR messages (BagWriterOptions::format; by
+// default for a ".mcap" path) with the ROS 2 names of the same types.
 //
 // IMU samples become sensor_msgs/Imu, ground-truth poses
 // geometry_msgs/PoseStamped or nav_msgs/Odometry

@@ -1,4 +1,5 @@
-// Writes one drone's simulated records: a ROS1 bag (IMU, LiDAR, ground truth)
+// Writes one drone's simulated records: a ROS1 bag or an MCAP file of ROS 2
+// messages (io::BagWriterOptions::format; IMU, LiDAR, ground truth)
 // and a TUM trajectory file (timestamp tx ty tz qx qy qz qw) of T_Gi_b; and
 // the run's resolved scenario (with the truth of every drawn imperfection)
 // and replay manifest (with the calibration handed to the estimator).
@@ -20,6 +21,10 @@ namespace swarmlio::sim {
 /// (its message_format and timestamp_unit): a drone's bag is written the way
 /// its sensor description says the driver publishes.
 io::BagWriterOptions BagOptionsFor(const io::BagWriterOptions& base, const LidarOptions& lidar);
+
+/// The bag file name of drone `name`: "<name>.mcap" when `options.format` is
+/// MCAP, else "<name>.bag" (ROS1; also for format auto).
+std::string BagFileName(const std::string& name, const io::BagWriterOptions& options);
 
 /// resolved_scenario.yaml: the run settings, each drone's T_W_Gi, sensors
 /// and imperfection settings as simulated, and a `truth:` block per drone
