@@ -118,10 +118,7 @@ std::string ReplayManifestYaml(const Scenario& s, const Simulator& sim) {
   for (size_t i = 0; i < sim.drones().size(); ++i) {
     const DroneConfig& d = sim.drones()[i];
     const Pose T = sim.T_W_G(static_cast<int>(i));
-    const SensorCalibration given = GivenCalibration(d);
-    LidarOptions lidar = d.lidar.sensor;
-    lidar.R_imu_lidar = given.R_imu_lidar;
-    lidar.p_lidar_in_imu_m = given.p_lidar_in_imu_m;
+    const LidarOptions lidar = GivenLidarOptions(d);
     os << "  - name: " << d.name << "\n";
     os << "    bag: " << BagFileName(d.name, s.bag) << "\n";
     os << "    # G_i in the simulation world W (for plots)\n";
@@ -137,7 +134,7 @@ std::string ReplayManifestYaml(const Scenario& s, const Simulator& sim) {
     os << Indented(config::DumpOptions(d.imu.sensor, "imu"), "    ");
     os << "    odometry:\n";
     os << "      # IMU stamps later than the LiDAR's (as calibrated)\n";
-    os << "      imu_time_offset_s: " << given.imu_time_offset_s << "\n";
+    os << "      imu_time_offset_s: " << GivenCalibration(d).imu_time_offset_s << "\n";
   }
   return os.str();
 }

@@ -24,6 +24,14 @@ SensorCalibration GivenCalibration(const DroneConfig& drone) {
   return c;
 }
 
+LidarOptions GivenLidarOptions(const DroneConfig& drone) {
+  const SensorCalibration given = GivenCalibration(drone);
+  LidarOptions lidar = drone.lidar.sensor;
+  lidar.R_imu_lidar = given.R_imu_lidar;
+  lidar.p_lidar_in_imu_m = given.p_lidar_in_imu_m;
+  return lidar;
+}
+
 Simulator::Simulator(Scene scene, std::vector<DroneConfig> drones,
                      std::vector<MovingObjectConfig> objects, const SimulationConfig& config)
     : scene_(std::move(scene)),

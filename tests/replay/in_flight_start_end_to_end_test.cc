@@ -1,17 +1,19 @@
 // A drone that starts its estimator in flight (issue #13, faults B: a late
 // join or a restart mid-flight), offline and deterministic: indoor_3uav
 // (realistic imperfections, the scenario's seed) is simulated for 36 s and
-// replayed with uav3 (the Avia) starting 20 s into its log, during its
-// excitation flight (manifest start_offset_s). With the static initialization
-// it assumes rest while moving: its trajectory, in its G (the IMU frame at
-// its initialization), is several centimetres off and its teammates' extrinsics
+// replayed, with the calibration the simulator reports as given, with uav3
+// (the Avia) starting 20 s into its log, during its excitation flight
+// (manifest start_offset_s). With the static initialization it assumes rest
+// while moving: its trajectory, in its G (the IMU frame at its
+// initialization), is several centimetres off and its teammates' extrinsics
 // of it are tilted by degrees. With initialization: in_flight (velocity and
 // gravity from LiDAR passes over its first scans) it tracks like a drone that
 // started at rest, and both teammates identify it within 15 s of its start
-// with a correct extrinsic (measured: 5.6 s, 2.1 cm / 0.66 deg and 2.5 cm /
-// 0.26 deg at the end; 6.2 s, 2.1 cm / 0.73 deg and 2.5 cm / 0.35 deg with the
-// clock synchronisation of session 10). SWARMLIO_IN_FLIGHT_REFERENCE=1 also prints uav3 from
-// rest with each method. docs/imu.md section 1b, results.md.
+// with a correct extrinsic (measured with the given calibration: 5.6 and
+// 5.7 s, 2.4 cm / 0.52 deg and 4.5 cm / 0.32 deg at the end; with the true
+// calibration 6.2 s, 1.3 cm / 0.70 deg and 2.6 cm / 0.43 deg).
+// SWARMLIO_IN_FLIGHT_REFERENCE=1 also prints uav3 from rest with each method.
+// docs/imu.md section 1b, results.md.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -224,10 +226,11 @@ TEST_F(InFlightStartTest, LateJoinerInitializedInFlightTracksAndIsIdentified) {
     Print("from rest, static", Run(lio::InitializationMode::kStatic, 0.0));
     Print("from rest, in_flight", Run(lio::InitializationMode::kInFlight, 0.0));
   }
-  // Measured: static 0.172 m (it initializes 8.9 s late, 0.18 m/s off),
-  // in_flight 0.016 m; uav3 from rest 0.015 m (SWARMLIO_IN_FLIGHT_REFERENCE=1).
+  // Measured (Release, the given calibration): static 0.182 m (it
+  // initializes 8.9 s late, 0.18 m/s off), in_flight 0.018 m (with the true
+  // calibration 0.146 and 0.020 m).
   EXPECT_GT(at_rest.position_rmse_m, 0.05);
-  EXPECT_LT(in_flight.position_rmse_m, 0.03);
+  EXPECT_LT(in_flight.position_rmse_m, 0.045);
   EXPECT_LT(in_flight.first_output_s, 1.5);  // the IMU window (1 s), then from its first scan
   // The scans its passes held (the probe window, 1.5 s at 10 Hz, and those
   // that came while the passes ran) are flagged, and only those: the live
@@ -241,8 +244,8 @@ TEST_F(InFlightStartTest, LateJoinerInitializedInFlightTracksAndIsIdentified) {
   for (int i = 0; i < 2; ++i) {
     EXPECT_GE(in_flight.identified_after_s[i], 0.0) << i;
     EXPECT_LE(in_flight.identified_after_s[i], 15.0) << i;
-    EXPECT_LT(in_flight.end_error_m[i], 0.06) << i;
-    EXPECT_LT(in_flight.end_error_deg[i], 1.0) << i;
+    EXPECT_LT(in_flight.end_error_m[i], 0.1) << i;
+    EXPECT_LT(in_flight.end_error_deg[i], 1.2) << i;
   }
 }
 
@@ -258,11 +261,14 @@ TEST_F(InFlightStartTest, RestartedDroneIsIdentifiedAgainWithItsNewG) {
   const LateDroneFigures f =
       Run(lio::InitializationMode::kInFlight, 18.0, kRestarted, /*restart=*/true);
   Print("restart, in_flight", f, kRestarted);
+  // Measured (Release, the given calibration): 0.0122 m; extrinsics at the
+  // end 0.0085 m / 0.191 deg and 0.0107 m / 0.422 deg (with the true
+  // calibration 0.0037 m; 0.0103 m / 0.081 deg and 0.0067 m / 0.341 deg).
   EXPECT_LT(f.position_rmse_m, 0.03);
   for (int i : {0, 2}) {
     EXPECT_GE(f.identified_after_s[i], 0.0) << i;
     EXPECT_LE(f.identified_after_s[i], 15.0) << i;
-    EXPECT_LT(f.end_error_m[i], 0.06) << i;
+    EXPECT_LT(f.end_error_m[i], 0.025) << i;
     EXPECT_LT(f.end_error_deg[i], 1.0) << i;
   }
 }

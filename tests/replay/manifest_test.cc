@@ -3,6 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
+#include <vector>
+
+#include "swarmlio/config/dump_options.h"
+#include "swarmlio/sim/output_writer.h"
+#include "swarmlio/sim/scenario.h"
+#include "swarmlio/sim/simulator.h"
+#include "test_utils/given_calibration.h"
 
 namespace swarmlio::driver {
 namespace {
@@ -119,6 +127,35 @@ TEST(Manifest, MarksSpinningLidars) {
                             "/tmp/m.yaml", &manifest)
                   .ok());
   EXPECT_FALSE(manifest.drones[0].bag.spinning_lidar);
+}
+
+// The tests hand a simulated drone's estimator what swarmlio_sim's swarm.yaml
+// does (test_utils/given_calibration.h): its sensors with the calibration the
+// simulator reports as given (realistic: off the truth), the odometry
+// defaults for them with the given IMU time offset.
+TEST(Manifest, SimulatorsManifestIsWhatTheTestsHandTheEstimator) {
+  sim::Scenario scenario;
+  ASSERT_TRUE(sim::LoadScenario(kPresets + "scenarios/indoor_3uav.yaml", &scenario).ok());
+  const std::vector<sim::DroneConfig> drones = scenario.drones;
+  const sim::Simulator simulator(std::move(scenario.scene), drones, scenario.objects,
+                                 scenario.simulation_config());
+  SwarmManifest manifest;
+  const Status status =
+      ParseManifest(sim::ReplayManifestYaml(scenario, simulator), "/tmp/swarm.yaml", &manifest);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(manifest.drones.size(), drones.size());
+  for (size_t i = 0; i < drones.size(); ++i) {
+    SCOPED_TRACE(drones[i].name);
+    const DroneInput given = swarmlio::testing::GivenDroneInput(drones[i]);
+    const DroneInput& read = manifest.drones[i];
+    EXPECT_EQ(read.name, given.name);
+    EXPECT_EQ(config::DumpOptions(read.lidar), config::DumpOptions(given.lidar));
+    EXPECT_EQ(config::DumpOptions(read.imu), config::DumpOptions(given.imu));
+    EXPECT_EQ(config::DumpOptions(read.bag), config::DumpOptions(given.bag));
+    EXPECT_EQ(config::DumpOptions(read.odometry), config::DumpOptions(given.odometry));
+    EXPECT_NE(given.lidar.p_lidar_in_imu_m, drones[i].lidar.sensor.p_lidar_in_imu_m);
+    EXPECT_NE(given.odometry.imu_time_offset_s, drones[i].imu.time_offset_s);
+  }
 }
 
 }  // namespace

@@ -88,10 +88,11 @@ TEST_F(SwarmEndToEndTest, TeammatesKeepTheWallFacingAviaFromDrifting) {
   }
   // uav1 (Avia) drifts alone, not with its teammates. (Alone over 0.2 m
   // before the noisy-plane projection, 0.19 m with it (lio.md "Noisy map
-  // planes"); with teammates 0.025 m.)
+  // planes"); with teammates 0.025 m. With the given calibration instead of
+  // the true one (Release): 0.53 m alone, 0.039 m with teammates.)
   EXPECT_GT(single[0], 0.1);
   EXPECT_GT(single[0], 4.0 * swarm[0]);
-  EXPECT_LT(swarm[0], 0.05);
+  EXPECT_LT(swarm[0], 0.1);
   // The observers (Mid-360) are no worse than alone (+10 %, +1 mm of slack
   // for millimetre-level figures).
   for (int i = 1; i < 3; ++i) EXPECT_LT(swarm[i], 1.1 * single[i] + 0.001);
@@ -174,7 +175,7 @@ TEST_F(SwarmEndToEndTest, RepeatedObservationsReplaceLostOnesAndNeverCountTwice)
 // offsets from the timestamps and echoes in the state broadcasts (the
 // default exchange) and maps their stamps onto its own clock,
 // so the Avia is held as with agreeing clocks, and every offset is known
-// within 2 ms. Taking the stamps as they come (synchronize_clocks off), the
+// within 0.5 ms. Taking the stamps as they come (synchronize_clocks off), the
 // Avia's observations are half a second off; on indoor_3uav that tripled
 // the Avia's error and lost a pair (docs/results.md).
 TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
@@ -213,7 +214,8 @@ TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
       std::printf("[ figures  ] %s -> %s: clock offset %.4f s, error %.3f ms\n",
                   d.input().name.c_str(), manifest.drones[j].name.c_str(), 1e-9 * truth_ns,
                   1e-6 * static_cast<double>(estimate.offset_ns - truth_ns));
-      EXPECT_LT(std::abs(estimate.offset_ns - truth_ns), 2'000'000) << i << " -> " << j;
+      // Measured within 0.21 ms (0.29 ms with the true calibration).
+      EXPECT_LT(std::abs(estimate.offset_ns - truth_ns), 500'000) << i << " -> " << j;
     }
   }
   eval::ConsistencyStats avia;
@@ -223,7 +225,7 @@ TEST(SwarmClockTest, TeammateClockOffsetsAreEstimatedAndApplied) {
                   .ok());
   std::printf("[ figures  ] wall-facing Avia with clocks 0.5 s apart: position RMSE %.4f m\n",
               avia.position_rmse_m);
-  EXPECT_LT(avia.position_rmse_m, 0.05);
+  EXPECT_LT(avia.position_rmse_m, 0.1);  // measured 0.041 m (0.027 m with the true calibration)
   std::error_code ec;
   fs::remove_all(dir, ec);
 }

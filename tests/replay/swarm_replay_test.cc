@@ -51,6 +51,7 @@ class SwarmReplayTest : public ::testing::Test {
                       .ok());
       sinks.push_back(writers[i].get());
     }
+    drones_ = new std::vector<sim::DroneConfig>(scenario.drones);
     sim::Simulator simulator(std::move(scenario.scene), scenario.drones, scenario.objects, config);
     std::vector<sim::DroneStats> stats;
     ASSERT_TRUE(simulator.Run(sinks, &stats).ok());
@@ -60,14 +61,23 @@ class SwarmReplayTest : public ::testing::Test {
     std::error_code ec;
     fs::remove_all(*dir_, ec);
     delete dir_;
+    delete drones_;
   }
 
+  // The bags with their sensor preset and the calibration the simulator
+  // reports as given (with its error, not the truth).
   static driver::SwarmManifest Manifest() {
     driver::SwarmManifest m;
     EXPECT_TRUE(driver::ManifestFromBags({(*dir_ / "uav1.bag").string(), (*dir_ / "uav2.bag").string()},
                                  std::string(SWARMLIO_SOURCE_DIR) + "/configs/livox_mid360.yaml",
                                  {"uav1", "uav2"}, &m)
                     .ok());
+    for (size_t i = 0; i < m.drones.size(); ++i) {
+      const sim::SensorCalibration given = sim::GivenCalibration((*drones_)[i]);
+      m.drones[i].lidar.R_imu_lidar = given.R_imu_lidar;
+      m.drones[i].lidar.p_lidar_in_imu_m = given.p_lidar_in_imu_m;
+      m.drones[i].odometry.imu_time_offset_s = given.imu_time_offset_s;
+    }
     return m;
   }
 
@@ -79,9 +89,11 @@ class SwarmReplayTest : public ::testing::Test {
   }
 
   static fs::path* dir_;
+  static std::vector<sim::DroneConfig>* drones_;  // as simulated
 };
 
 fs::path* SwarmReplayTest::dir_ = nullptr;
+std::vector<sim::DroneConfig>* SwarmReplayTest::drones_ = nullptr;
 
 ReplayOptions LossyNetwork(int64_t seed) {
   ReplayOptions options;

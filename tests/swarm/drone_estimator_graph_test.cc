@@ -98,8 +98,10 @@ TEST(DroneEstimator, ReidentifiesARestartedTeammateThroughAGraphDerivedTeammate)
   std::printf("[ figures  ] re-identified %.2f s after the removal, T_G0_G1 error %.4f m %.3f deg "
               "(1-sigma >= %.4f m)\n", after_s, r.error_m, r.error_deg, r.sigma_p_m);
   EXPECT_LT(after_s, 1.5);
-  EXPECT_LT(r.error_m, 0.05);
-  EXPECT_LT(r.error_deg, 0.7);
+  // Measured 0.0285 m / 0.494 deg (Release, the given calibration; 0.0234 m /
+  // 0.434 deg with the true one).
+  EXPECT_LT(r.error_m, 0.07);
+  EXPECT_LT(r.error_deg, 1.2);
   // Composed from two edges of 1 cm each (drone 2's block, T_G2_G1): not
   // more certain than either.
   EXPECT_GT(r.sigma_p_m, 0.009);
@@ -127,8 +129,9 @@ TEST(DroneEstimator, ReidentifiesARestartedTeammateThroughTheInverseOfADerivedEn
   std::printf("[ figures  ] re-identified %.2f s after the removal, T_G0_G1 error %.4f m %.3f deg\n",
               after_s, r.error_m, r.error_deg);
   EXPECT_LT(after_s, 1.5);
-  EXPECT_LT(r.error_m, 0.05);
-  EXPECT_LT(r.error_deg, 0.7);
+  // Measured 0.0296 m / 0.524 deg (0.0246 m / 0.434 deg with the true calibration).
+  EXPECT_LT(r.error_m, 0.07);
+  EXPECT_LT(r.error_deg, 1.2);
 }
 
 }  // namespace

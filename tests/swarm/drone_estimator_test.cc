@@ -43,10 +43,10 @@ TEST(DroneEstimator, RejectsInvalidOptionsAndIds) {
   const sim::DroneConfig& d = scenario.drones[0];
   std::unique_ptr<DroneEstimator> e;
   DroneEstimatorOptions o = OptionsFor(d);
-  EXPECT_EQ(DroneEstimator::Create(-1, o, d.lidar.sensor, &e).code(),
+  EXPECT_EQ(DroneEstimator::Create(-1, o, sim::GivenLidarOptions(d), &e).code(),
             Status::Code::kInvalidArgument);
   o.swarm.max_message_age_s = -1.0;
-  const Status status = DroneEstimator::Create(0, o, d.lidar.sensor, &e);
+  const Status status = DroneEstimator::Create(0, o, sim::GivenLidarOptions(d), &e);
   EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
   EXPECT_NE(status.message().find("swarm.max_message_age_s"), std::string::npos)
       << status.message();
@@ -59,7 +59,7 @@ TEST(DroneEstimator, IgnoresOwnForeignTypedAndNonFiniteMessages) {
   ASSERT_FALSE(scenario.drones.empty());
   const sim::DroneConfig& d = scenario.drones[0];
   std::unique_ptr<DroneEstimator> e;
-  ASSERT_TRUE(DroneEstimator::Create(0, OptionsFor(d), d.lidar.sensor, &e).ok());
+  ASSERT_TRUE(DroneEstimator::Create(0, OptionsFor(d), sim::GivenLidarOptions(d), &e).ok());
   net::ReceivedMessage own;
   net::EgoStateMessage m;
   m.sender_id = 0;
@@ -90,7 +90,7 @@ TEST(DroneEstimator, SynchronizesTeammateClocksBeforeUsingTheirStamps) {
   o.swarm.synchronize_clocks = true;
   o.swarm.clock_sync.exchange = net::ClockExchange::kRequests;
   std::unique_ptr<DroneEstimator> e;
-  ASSERT_TRUE(DroneEstimator::Create(0, o, d.lidar.sensor, &e).ok());
+  ASSERT_TRUE(DroneEstimator::Create(0, o, sim::GivenLidarOptions(d), &e).ok());
   const int64_t t0 = 1'000'000'000'000;  // 1000 s on the own clock
   const int64_t offset = 500'000'000;    // the teammate's clock is 0.5 s ahead
   ImuSample imu;
@@ -220,7 +220,8 @@ TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) 
               "fused, T_Gi_Gj error %.4f m %.3f deg (1-sigma %.4f %.4f %.4f m)\n",
               identified_at, removed_at, active, passive, p_err, r_err, sigma.x(), sigma.y(),
               sigma.z());
-  EXPECT_LT(p_err, 0.05);
+  // Measured 0.0105 m / 0.348 deg (Release, the given calibration).
+  EXPECT_LT(p_err, 0.03);
   EXPECT_LT(r_err, 1.0);
   // The reported uncertainty is neither absurdly small nor large.
   EXPECT_LT(sigma.maxCoeff(), 0.05);
@@ -242,7 +243,8 @@ TEST(DroneEstimator, IdentifiesATeammateFusesItsObservationsAndDropsItOnReboot) 
     }
   }
   ASSERT_GT(n, 100);
-  EXPECT_LT(std::sqrt(se / n), 0.02);
+  std::printf("[ figures  ] ego position RMSE %.4f m\n", std::sqrt(se / n));
+  EXPECT_LT(std::sqrt(se / n), 0.012);  // measured 0.0044 m
 }
 
 // The teammate identified this drone first and sends T_Gj_Gi: the component
@@ -285,7 +287,10 @@ TEST(DroneEstimator, AddsATeammateThatIdentifiedItFromItsExtrinsic) {
   ASSERT_EQ(last.teammates.size(), 1u);
   const Eigen::Isometry3d T_true =
       ToIsometry(simulator.T_W_G(observer)).inverse() * ToIsometry(simulator.T_W_G(teammate));
-  EXPECT_LT((last.teammates[0].T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm(), 0.03);
+  const double p_err = (last.teammates[0].T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm();
+  std::printf("[ figures  ] identified at %.2f s, T_Gi_Gj error at the end %.4f m\n", identified_s,
+              p_err);
+  EXPECT_LT(p_err, 0.015);  // measured 0.0058 m
   EXPECT_EQ(run.estimator().counters().extrinsics_stale, 0);
 }
 
@@ -300,7 +305,7 @@ TEST(DroneEstimator, IgnoresTeammatesExtrinsicsOfItsPreviousSession) {
   DroneEstimatorOptions o = OptionsFor(d);
   o.swarm.synchronize_clocks = false;  // stamps taken as own-clock stamps
   std::unique_ptr<DroneEstimator> e;
-  ASSERT_TRUE(DroneEstimator::Create(0, o, d.lidar.sensor, &e).ok());
+  ASSERT_TRUE(DroneEstimator::Create(0, o, sim::GivenLidarOptions(d), &e).ok());
   const int64_t t0 = 1'000'000'000'000;
   ImuSample imu;
   imu.linear_acceleration = Eigen::Vector3d(0, 0, 9.81);
@@ -369,9 +374,13 @@ TEST(DroneEstimator, AddsATeammateThroughAnIdentifiedTeammate) {
     SCOPED_TRACE(t.drone_id);
     const Eigen::Isometry3d T_true = ToIsometry(simulator.T_W_G(observer)).inverse() *
                                      ToIsometry(simulator.T_W_G(t.drone_id));
-    EXPECT_LT((t.T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm(), 0.03);
+    const double p_err = (t.T_Gi_Gj.p_Gb_in_Ga - T_true.translation()).norm();
     const double angle =
         Eigen::AngleAxisd(t.T_Gi_Gj.R_Ga_Gb().transpose() * T_true.linear()).angle();
+    std::printf("[ figures  ] T_G%d_G%d error at the end %.4f m %.3f deg\n", observer, t.drone_id,
+                p_err, angle * 180.0 / M_PI);
+    // Measured 0.0053 m / 0.161 deg (T_G0_G1), 0.0241 m / 0.197 deg (T_G0_G2).
+    EXPECT_LT(p_err, 0.06);
     EXPECT_LT(angle, 0.5 * M_PI / 180.0);
     // At least the relayed entry's own uncertainty (1 cm): composing cannot
     // make it more certain than its parts.

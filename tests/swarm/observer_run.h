@@ -1,10 +1,12 @@
 // Test support for swarm::DroneEstimator without a bag or the replay: one
 // simulated drone of indoor_3uav feeds the component with its IMU and LiDAR
-// (ObserverRun), and a teammate's broadcasts are made from the simulator's
-// truth (ObserverSink: its state in its own G_j, stamps in the observer's
-// clock, 20 ms latency, every scan; each with the teammate's observation of
-// the observer, 2 cm noise). The records, the broadcasts among them, go
-// through driver::DroneDriver, the loop the replay and the live process run;
+// (ObserverRun; the component is given the calibration the simulator reports
+// as given, with its error, as swarm.yaml would: GivenDroneInput), and a
+// teammate's broadcasts are made from the simulator's truth (ObserverSink:
+// its state in its own G_j, stamps in the observer's clock, 20 ms latency,
+// every scan; each with the teammate's observation of the observer, 2 cm
+// noise). The records, the broadcasts among them, go through
+// driver::DroneDriver, the loop the replay and the live process run;
 // ObserverSink is its sink. Shared by the tests in tests/swarm/.
 #pragma once
 
@@ -28,6 +30,7 @@
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
 #include "swarmlio/swarm/drone_estimator.h"
+#include "test_utils/given_calibration.h"
 
 namespace swarmlio::swarm::test_support {
 
@@ -50,8 +53,7 @@ inline sim::Scenario IndoorScenario() {
 
 inline DroneEstimatorOptions OptionsFor(const sim::DroneConfig& d) {
   DroneEstimatorOptions o;
-  o.odometry = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
-  o.odometry.imu_time_offset_s = d.imu.time_offset_s;
+  o.odometry = swarmlio::testing::GivenDroneInput(d).odometry;
   // The sinks below hand over the teammate's states stamped on one clock
   // without TimeSync exchanges; clock synchronisation has its own test.
   o.swarm.synchronize_clocks = false;
@@ -61,10 +63,7 @@ inline DroneEstimatorOptions OptionsFor(const sim::DroneConfig& d) {
 // The observer as a driver's drone: its sensors and the component's options
 // `o` (driver::EstimatorOptionsFor gives `o` back).
 inline driver::DroneInput InputFor(const sim::DroneConfig& d, const DroneEstimatorOptions& o) {
-  driver::DroneInput input;
-  input.name = d.name;
-  input.lidar = d.lidar.sensor;
-  input.imu = d.imu.sensor;
+  driver::DroneInput input = swarmlio::testing::GivenDroneInput(d);
   input.odometry = o.odometry;
   input.teammate = o.teammate;
   input.swarm = o.swarm;

@@ -1,8 +1,9 @@
 // Test helper: simulates a scenario file into one bag and ground-truth file
 // per drone under `dir` and fills the replay manifest that reads them back,
-// with each drone's sensor presets, default odometry options and the IMU time
-// offset as if calibrated. Header-only; the test executable links swarmlio_sim
-// and swarmlio_replay.
+// as swarmlio_sim's swarm.yaml does: each drone's sensors with the
+// calibration the simulator reports as given (not the truth) and default
+// odometry options (given_calibration.h). Header-only; the test executable
+// links swarmlio_sim and swarmlio_replay.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -18,6 +19,7 @@
 #include "swarmlio/sim/output_writer.h"
 #include "swarmlio/sim/scenario.h"
 #include "swarmlio/sim/simulator.h"
+#include "test_utils/given_calibration.h"
 
 namespace swarmlio::testing {
 
@@ -46,14 +48,8 @@ inline ::testing::AssertionResult SimulateSwarm(
                                      sim::BagOptionsFor(scenario.bag, d.lidar.sensor), &writers[i]);
     if (!opened.ok()) return ::testing::AssertionFailure() << opened.message();
     sinks.push_back(writers[i].get());
-    driver::DroneInput input;
-    input.name = d.name;
+    driver::DroneInput input = GivenDroneInput(d);
     input.bag_path = stem + ".bag";
-    input.lidar = d.lidar.sensor;
-    input.imu = d.imu.sensor;
-    input.bag.point_time_unit = d.lidar.sensor.timestamp_unit;
-    input.odometry = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
-    input.odometry.imu_time_offset_s = d.imu.time_offset_s;  // as if calibrated
     input.true_clock.offset_s = d.clock_offset_s;  // packet delivery only
     input.true_clock.drift_ppm = d.clock_drift_ppm;
     input.true_clock.origin_s = config.stamp_origin_s;

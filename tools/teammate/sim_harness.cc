@@ -272,11 +272,9 @@ Status EstimateEgoTrajectories(const sim::Simulator& sim,
     // The calibration handed to the estimator (with the scenario's error), as
     // a real drone's swarm.yaml would be: not the truth the simulator uses.
     out.calibration = sim::GivenCalibration(d);
-    lio::OdometryOptions options = driver::DefaultOdometryOptions(d.lidar.sensor, d.imu.sensor);
+    const LidarOptions lidar = sim::GivenLidarOptions(d);
+    lio::OdometryOptions options = driver::DefaultOdometryOptions(lidar, d.imu.sensor);
     options.imu_time_offset_s = out.calibration.imu_time_offset_s;
-    LidarOptions lidar = d.lidar.sensor;
-    lidar.R_imu_lidar = out.calibration.R_imu_lidar;
-    lidar.p_lidar_in_imu_m = out.calibration.p_lidar_in_imu_m;
     SWARMLIO_RETURN_IF_ERROR(lio::Odometry::Create(options, lidar, &odometries[j]));
     sinks[j] = std::make_unique<OdometrySink>(odometries[j].get(), &out.states);
     sink_pointers[j] = sinks[j].get();

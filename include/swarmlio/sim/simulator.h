@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "swarmlio/common/status.h"
+#include "swarmlio/sensors/lidar_options.h"
 #include "swarmlio/sensors/measurements.h"
 #include "swarmlio/sim/drone_body.h"
 #include "swarmlio/sim/imperfections.h"
@@ -43,6 +44,9 @@ struct DroneConfig {
 SensorCalibration TrueCalibration(const DroneConfig& drone);
 /// The calibration handed to the estimator: the truth with calibration_error.
 SensorCalibration GivenCalibration(const DroneConfig& drone);
+/// The drone's LiDAR as the estimator is told it (swarm.yaml's `lidar:`): the
+/// simulated sensor with the given extrinsic (GivenCalibration), never the truth.
+LidarOptions GivenLidarOptions(const DroneConfig& drone);
 
 struct MovingObjectConfig {
   std::string name;
