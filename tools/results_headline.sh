@@ -55,24 +55,11 @@ mean() {
 # pairs <swarm_pairs.csv files...>: the teammate columns.
 pairs() {
   [[ $# -gt 0 ]] || { echo "n/a | n/a | n/a | n/a | n/a"; return; }
-  awk -F, '
-    FNR == 1 { delete c; for (i = 1; i <= NF; ++i) c[$i] = i; next }
-    { total++
-      if ($c["identified"] != 1) next
-      ident++
-      wrong += $c["wrong_identification"]
-      if ($c["since_excitation_s"] > late) late = $c["since_excitation_s"]
-      if ($c["extrinsic_end_m"] > em) em = $c["extrinsic_end_m"]
-      if ($c["extrinsic_end_deg"] > ed) ed = $c["extrinsic_end_deg"]
-      if ($c["relative_rmse_m"] > rel) rel = $c["relative_rmse_m"]
-      v = $c["scans_in_view"]; f = $c["fused_in_view"]
-      if (v > 0) { sv += v; sf += f; share = f / v; if (!np++ || share < worst) worst = share }
-    }
-    END {
-      printf "%d / %d, %d wrong | %.1f | %.1f / %.2f | %.1f | ", ident, total, wrong, late,
-             100 * em, ed, 100 * rel
-      if (np) printf "%.0f (%.0f)", 100 * sf / sv, 100 * worst; else printf "n/a"
-    }' "$@"
+  awk -F, -f "$(dirname "${BASH_SOURCE[0]}")/pairs_summary.awk" "$@" | awk '{
+    printf "%d / %d, %d wrong | %.1f | %.1f / %.2f | %.1f | ", $1, $2, $3, $4, 100 * $5, $6,
+           100 * $9
+    if ($10 >= 0) printf "%.0f (%.0f)", 100 * $10, 100 * $11; else printf "n/a"
+  }'
 }
 
 # bytes_per_s <duration_s> <network.csv files...>: the largest broadcast rate

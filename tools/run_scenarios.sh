@@ -187,25 +187,11 @@ for name in "${scenarios[@]}"; do
     for seed in "${seeds[@]}"; do
       csv="$OUT/$name/seed$seed/swarm/swarm_pairs.csv"
       [[ -f "$csv" ]] || { echo "| $seed | n/a | | | | | |"; continue; }
-      awk -F, -v seed="$seed" '
-        NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
-        { total++
-          if ($c["identified"] != 1) next
-          ident++; wrong += $c["wrong_identification"]
-          if ($c["since_excitation_s"] > late) late = $c["since_excitation_s"]
-          if ($c["extrinsic_end_m"] > em) em = $c["extrinsic_end_m"]
-          if ($c["extrinsic_end_deg"] > ed) ed = $c["extrinsic_end_deg"]
-          if ($c["extrinsic_max_m"] > xm) xm = $c["extrinsic_max_m"]
-          if ($c["extrinsic_max_deg"] > xd) xd = $c["extrinsic_max_deg"]
-          if ($c["relative_rmse_m"] > rel) rel = $c["relative_rmse_m"]
-          v = $c["scans_in_view"]; f = $c["fused_in_view"]
-          if (v > 0) { sv += v; sf += f; share = f / v; if (!np++ || share < worst) worst = share }
-        }
-        END {
-          printf "| %s | %d / %d (%d) | %.1f | %.3f / %.2f | %.3f / %.2f | %.3f | ", seed, ident,
-                 total, wrong, late, em, ed, xm, xd, rel
-          if (np) printf "%.0f (%.0f) |\n", 100 * sf / sv, 100 * worst; else printf "n/a |\n"
-        }' "$csv"
+      awk -F, -f "$ROOT/tools/pairs_summary.awk" "$csv" | awk -v seed="$seed" '{
+        printf "| %s | %d / %d (%d) | %.1f | %.3f / %.2f | %.3f / %.2f | %.3f | ", seed, $1, $2,
+               $3, $4, $5, $6, $7, $8, $9
+        if ($10 >= 0) printf "%.0f (%.0f) |\n", 100 * $10, 100 * $11; else printf "n/a |\n"
+      }'
     done
   } >> "$DOC"
 done
