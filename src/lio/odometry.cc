@@ -16,6 +16,7 @@
 #include "swarmlio/lio/preprocess.h"
 #include "swarmlio/lio/scan_association.h"
 #include "swarmlio/lio/undistortion.h"
+#include "swarmlio/math/angles.h"
 
 namespace swarmlio::lio {
 namespace {
@@ -350,7 +351,7 @@ Eigen::Matrix3d Odometry::PositionCovarianceInG(const ScanOutput& out) {
   Eigen::Matrix3d cov = out.covariance.block<3, 3>(kP, kP);
   if (im.have_anchor) {
     CalibrationUncertainty calibration;
-    calibration.rotation_sigma_rad = lidar_.calibration_rotation_sigma_deg * M_PI / 180.0;
+    calibration.rotation_sigma_rad = lidar_.calibration_rotation_sigma_deg * kRadiansPerDegree;
     calibration.translation_sigma_m = lidar_.calibration_translation_sigma_m;
     cov += CalibrationGaugeCovariance(calibration, im.anchor, R_G_b, out.state.p_b_in_G);
   }
