@@ -1,5 +1,6 @@
 #include "src/io/bag_source.h"
 
+
 #include <ros/serialization.h>
 #include <rosbag/bag.h>
 #include <rosbag/query.h>
@@ -14,6 +15,7 @@
 #include "src/io/bag_precheck.h"
 #include "src/io/bag_recovery.h"
 #include "src/io/db3_source.h"
+#include "src/io/topic_index.h"
 #include "src/io/mcap_source.h"
 #include "src/io/ros_time.h"
 #include "src/io/rosbag2_folder.h"
@@ -188,72 +190,55 @@ class RecoveredTopicStream : public TopicMessageStream {
 };
 
 class RecoveredSource : public BagSource {
+ private:
+  // Message i's time (defined first: the members below deduce from it).
+  auto TimeOf() const {
+    return [this](size_t i) { return bag_.messages[i].time_ns; };
+  }
+
  public:
   Status Load(const std::string& path, const std::string& reason) {
     SWARMLIO_RETURN_IF_ERROR(ScanBagRecords(path, reason, &bag_));
     for (const RecoveredConnection& c : bag_.connections) {
       connections_.push_back({c.topic, c.datatype, c.md5sum});
     }
-    for (size_t i = 0; i < bag_.messages.size(); ++i) {
-      const RecoveredMessage& m = bag_.messages[i];
-      by_topic_[bag_.connections[m.connection].topic].push_back(i);
-      if (i == 0 || m.time_ns < start_time_ns_) start_time_ns_ = m.time_ns;
-      if (i == 0 || m.time_ns > end_time_ns_) end_time_ns_ = m.time_ns;
-    }
     // rosbag's order: bag time, equal times in file order.
-    for (auto& entry : by_topic_) {
-      std::stable_sort(entry.second.begin(), entry.second.end(), [this](size_t a, size_t b) {
-        return bag_.messages[a].time_ns < bag_.messages[b].time_ns;
-      });
-    }
+    index_.Build(
+        bag_.messages.size(),
+        [this](size_t i) -> const std::string& {
+          return bag_.connections[bag_.messages[i].connection].topic;
+        },
+        TimeOf());
     return Status::Ok();
   }
 
   const std::vector<SourceConnection>& connections() const override { return connections_; }
   int64_t message_count() const override { return static_cast<int64_t>(bag_.messages.size()); }
-  int64_t start_time_ns() const override { return start_time_ns_; }
-  int64_t end_time_ns() const override { return end_time_ns_; }
+  int64_t start_time_ns() const override { return index_.start_time_ns(); }
+  int64_t end_time_ns() const override { return index_.end_time_ns(); }
   const BagRecoveryStats& recovery() const override { return bag_.stats; }
 
   Status Summarize(const std::string& topic, TopicSummary* summary) override {
-    *summary = TopicSummary();
-    const std::vector<size_t>& messages = Messages(topic);
-    summary->message_count = static_cast<int64_t>(messages.size());
-    if (!messages.empty()) {
-      summary->first_time_ns = bag_.messages[messages.front()].time_ns;
-      summary->last_time_ns = bag_.messages[messages.back()].time_ns;
-    }
+    index_.Summarize(topic, TimeOf(), summary);
     return Status::Ok();
   }
 
   Status TopicTimes(const std::string& topic,
                     size_t max_count,
                     std::vector<int64_t>* times) override {
-    times->clear();
-    for (size_t i : Messages(topic)) {
-      if (times->size() >= max_count) break;
-      times->push_back(bag_.messages[i].time_ns);
-    }
+    index_.TopicTimes(topic, max_count, TimeOf(), times);
     return Status::Ok();
   }
 
   Status OpenTopic(const std::string& topic, std::unique_ptr<TopicMessageStream>* stream) override {
-    *stream = std::make_unique<RecoveredTopicStream>(&bag_, Messages(topic));
+    *stream = std::make_unique<RecoveredTopicStream>(&bag_, index_.Messages(topic));
     return Status::Ok();
   }
 
  private:
-  const std::vector<size_t>& Messages(const std::string& topic) const {
-    static const std::vector<size_t>* const kNone = new std::vector<size_t>();
-    const auto it = by_topic_.find(topic);
-    return it == by_topic_.end() ? *kNone : it->second;
-  }
-
   RecoveredBag bag_;
   std::vector<SourceConnection> connections_;
-  std::map<std::string, std::vector<size_t>> by_topic_;
-  int64_t start_time_ns_ = 0;
-  int64_t end_time_ns_ = 0;
+  internal::TopicIndex index_;
 };
 
 }  // namespace

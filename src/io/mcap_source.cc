@@ -8,6 +8,7 @@
 
 #include "src/io/mcap_format.h"
 #include "src/io/mcap_scan.h"
+#include "src/io/topic_index.h"
 
 namespace swarmlio::io::internal {
 namespace {
@@ -39,6 +40,12 @@ class McapTopicStream : public TopicMessageStream {
 };
 
 class McapSource : public BagSource {
+ private:
+  // Message i's time (defined first: the members below deduce from it).
+  auto TimeOf() const {
+    return [this](size_t i) { return file_.messages[i].log_time_ns; };
+  }
+
  public:
   Status Load(const std::string& path, bool recover) {
     SWARMLIO_RETURN_IF_ERROR(ScanMcapFile(path, recover, &file_));
@@ -51,65 +58,42 @@ class McapSource : public BagSource {
       if (md5 != c.metadata.end()) connection.md5sum = md5->second;
       connections_.push_back(std::move(connection));
     }
-    for (size_t i = 0; i < file_.messages.size(); ++i) {
-      const McapMessage& m = file_.messages[i];
-      by_topic_[file_.channels[m.channel].topic].push_back(i);
-      if (i == 0 || m.log_time_ns < start_time_ns_) start_time_ns_ = m.log_time_ns;
-      if (i == 0 || m.log_time_ns > end_time_ns_) end_time_ns_ = m.log_time_ns;
-    }
-    for (auto& entry : by_topic_) {
-      std::stable_sort(entry.second.begin(), entry.second.end(), [this](size_t a, size_t b) {
-        return file_.messages[a].log_time_ns < file_.messages[b].log_time_ns;
-      });
-    }
+    index_.Build(
+        file_.messages.size(),
+        [this](size_t i) -> const std::string& {
+          return file_.channels[file_.messages[i].channel].topic;
+        },
+        TimeOf());
     return Status::Ok();
   }
 
   const std::vector<SourceConnection>& connections() const override { return connections_; }
   int64_t message_count() const override { return static_cast<int64_t>(file_.messages.size()); }
-  int64_t start_time_ns() const override { return start_time_ns_; }
-  int64_t end_time_ns() const override { return end_time_ns_; }
+  int64_t start_time_ns() const override { return index_.start_time_ns(); }
+  int64_t end_time_ns() const override { return index_.end_time_ns(); }
   const BagRecoveryStats& recovery() const override { return file_.damage; }
 
   Status Summarize(const std::string& topic, TopicSummary* summary) override {
-    *summary = TopicSummary();
-    const std::vector<size_t>& messages = Messages(topic);
-    summary->message_count = static_cast<int64_t>(messages.size());
-    if (!messages.empty()) {
-      summary->first_time_ns = file_.messages[messages.front()].log_time_ns;
-      summary->last_time_ns = file_.messages[messages.back()].log_time_ns;
-    }
+    index_.Summarize(topic, TimeOf(), summary);
     return Status::Ok();
   }
 
   Status TopicTimes(const std::string& topic,
                     size_t max_count,
                     std::vector<int64_t>* times) override {
-    times->clear();
-    for (size_t i : Messages(topic)) {
-      if (times->size() >= max_count) break;
-      times->push_back(file_.messages[i].log_time_ns);
-    }
+    index_.TopicTimes(topic, max_count, TimeOf(), times);
     return Status::Ok();
   }
 
   Status OpenTopic(const std::string& topic, std::unique_ptr<TopicMessageStream>* stream) override {
-    *stream = std::make_unique<McapTopicStream>(&file_, Messages(topic));
+    *stream = std::make_unique<McapTopicStream>(&file_, index_.Messages(topic));
     return Status::Ok();
   }
 
  private:
-  const std::vector<size_t>& Messages(const std::string& topic) const {
-    static const std::vector<size_t>* const kNone = new std::vector<size_t>();
-    const auto it = by_topic_.find(topic);
-    return it == by_topic_.end() ? *kNone : it->second;
-  }
-
   McapFile file_;
   std::vector<SourceConnection> connections_;
-  std::map<std::string, std::vector<size_t>> by_topic_;
-  int64_t start_time_ns_ = 0;
-  int64_t end_time_ns_ = 0;
+  internal::TopicIndex index_;
 };
 
 }  // namespace
