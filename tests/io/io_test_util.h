@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "swarmlio/io/bag_reader.h"
 #include "swarmlio/sensors/measurements.h"
-
 #include "test_utils/temp_dir.h"
 
 namespace swarmlio::io::testing {
@@ -134,6 +134,19 @@ inline void ExpectScanEqual(const LidarScan& a, const LidarScan& b) {
         << k << ": " << p.offset_time_s << " vs " << q.offset_time_s;
     EXPECT_EQ(p.tag, q.tag) << k;
     EXPECT_EQ(p.line, q.line) << k;
+  }
+}
+
+/// The same records in the same order, bit for bit.
+inline void ExpectSameRecords(const std::vector<BagRecord>& a, const std::vector<BagRecord>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].data.index(), b[i].data.index()) << i;
+    if (a[i].imu() != nullptr) ExpectImuEqual(*a[i].imu(), *b[i].imu());
+    if (a[i].scan() != nullptr) ExpectScanEqual(*a[i].scan(), *b[i].scan());
+    if (a[i].ground_truth() != nullptr) {
+      ExpectPoseEqual(*a[i].ground_truth(), *b[i].ground_truth());
+    }
   }
 }
 

@@ -82,18 +82,6 @@ std::vector<std::pair<uint8_t, Bytes>> Messages(int i) {
   return records;
 }
 
-void ExpectSameRecords(const std::vector<BagRecord>& a, const std::vector<BagRecord>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (size_t i = 0; i < a.size(); ++i) {
-    ASSERT_EQ(a[i].data.index(), b[i].data.index()) << i;
-    if (a[i].imu() != nullptr) testing::ExpectImuEqual(*a[i].imu(), *b[i].imu());
-    if (a[i].scan() != nullptr) testing::ExpectScanEqual(*a[i].scan(), *b[i].scan());
-    if (a[i].ground_truth() != nullptr) {
-      testing::ExpectPoseEqual(*a[i].ground_truth(), *b[i].ground_truth());
-    }
-  }
-}
-
 TEST(McapReaderTest, WrittenMcapReadsBackLikeTheRos1Bag) {
   TempDir dir;
   struct Case {
@@ -122,7 +110,7 @@ TEST(McapReaderTest, WrittenMcapReadsBackLikeTheRos1Bag) {
         ReadAll(dir.File("run.mcap"), BagReaderOptions(), &from_mcap, &mcap_stats);
     ASSERT_TRUE(status.ok()) << status.message();
     EXPECT_EQ(from_mcap.size(), 300u + 15u + 30u);
-    ExpectSameRecords(from_mcap, from_bag);
+    testing::ExpectSameRecords(from_mcap, from_bag);
     EXPECT_EQ(mcap_stats.ToString(), bag_stats.ToString());
     EXPECT_FALSE(mcap_stats.recovery.recovered);
 
@@ -150,7 +138,7 @@ TEST(McapReaderTest, FormatIsToldByTheMagicBytesNotTheExtension) {
   std::vector<BagRecord> a, b;
   ASSERT_TRUE(ReadAll(dir.File("really_mcap.bag"), BagReaderOptions(), &a).ok());
   ASSERT_TRUE(ReadAll(dir.File("really_ros1.mcap"), BagReaderOptions(), &b).ok());
-  ExpectSameRecords(a, b);
+  testing::ExpectSameRecords(a, b);
   BagInfo info;
   ASSERT_TRUE(ReadBagInfo(dir.File("really_mcap.bag"), &info).ok());
   EXPECT_EQ(info.topics[0].datatype, "geometry_msgs/msg/PoseStamped");

@@ -87,18 +87,6 @@ std::string Metadata(const std::string& storage, const std::vector<std::string>&
   return text;
 }
 
-void ExpectSameRecords(const std::vector<BagRecord>& a, const std::vector<BagRecord>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (size_t i = 0; i < a.size(); ++i) {
-    ASSERT_EQ(a[i].data.index(), b[i].data.index()) << i;
-    if (a[i].imu() != nullptr) testing::ExpectImuEqual(*a[i].imu(), *b[i].imu());
-    if (a[i].scan() != nullptr) testing::ExpectScanEqual(*a[i].scan(), *b[i].scan());
-    if (a[i].ground_truth() != nullptr) {
-      testing::ExpectPoseEqual(*a[i].ground_truth(), *b[i].ground_truth());
-    }
-  }
-}
-
 class Rosbag2Test : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -119,7 +107,7 @@ TEST_F(Rosbag2Test, Db3FileReadsLikeTheRos1Bag) {
   std::vector<BagRecord> records;
   const Status status = ReadAll(dir_.File("run.db3"), BagReaderOptions(), &records);
   ASSERT_TRUE(status.ok()) << status.message();
-  ExpectSameRecords(records, expected_);
+  testing::ExpectSameRecords(records, expected_);
   BagInfo info;
   ASSERT_TRUE(ReadBagInfo(dir_.File("run.db3"), &info).ok());
   EXPECT_EQ(info.format, "db3");
@@ -139,7 +127,7 @@ TEST_F(Rosbag2Test, SplitFolderReadsAsOneLog) {
   std::vector<BagRecord> records;
   const Status status = ReadAll(folder, BagReaderOptions(), &records);
   ASSERT_TRUE(status.ok()) << status.message();
-  ExpectSameRecords(records, expected_);
+  testing::ExpectSameRecords(records, expected_);
   BagInfo info;
   ASSERT_TRUE(ReadBagInfo(folder, &info).ok());
   EXPECT_EQ(info.format, "rosbag2");
@@ -149,11 +137,11 @@ TEST_F(Rosbag2Test, SplitFolderReadsAsOneLog) {
   WriteText(folder + "/metadata.yaml",
             Metadata("sqlite3", {"split/split_0.db3", "split/split_1.db3"}));
   ASSERT_TRUE(ReadAll(folder, BagReaderOptions(), &records).ok());
-  ExpectSameRecords(records, expected_);
+  testing::ExpectSameRecords(records, expected_);
   // Without metadata.yaml: the .db3 files in name order.
   std::filesystem::remove(folder + "/metadata.yaml");
   ASSERT_TRUE(ReadAll(folder, BagReaderOptions(), &records).ok());
-  ExpectSameRecords(records, expected_);
+  testing::ExpectSameRecords(records, expected_);
 }
 
 TEST_F(Rosbag2Test, McapFolderAndBadMetadata) {
@@ -163,7 +151,7 @@ TEST_F(Rosbag2Test, McapFolderAndBadMetadata) {
   WriteText(folder + "/metadata.yaml", Metadata("mcap", {"mcap_folder_0.mcap"}));
   std::vector<BagRecord> records;
   ASSERT_TRUE(ReadAll(folder, BagReaderOptions(), &records).ok());
-  ExpectSameRecords(records, expected_);
+  testing::ExpectSameRecords(records, expected_);
   WriteText(folder + "/metadata.yaml", Metadata("mcap", {"missing.mcap"}));
   Status status = ReadAll(folder, BagReaderOptions(), &records);
   EXPECT_EQ(status.code(), Status::Code::kNotFound) << status.message();
