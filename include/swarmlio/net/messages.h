@@ -23,6 +23,7 @@ enum class MessageType : uint8_t {
   kEgoState = 1,
   kGlobalExtrinsic = 2,
   kTimeSync = 3,
+  kAirframe = 4,
 };
 
 const char* MessageTypeName(MessageType type);
@@ -168,7 +169,25 @@ struct TimeSyncMessage {
   int64_t t3_ns = 0;  // response send, responder clock (0 in a request)
 };
 
-using SwarmMessage = std::variant<EgoStateMessage, GlobalExtrinsicMessage, TimeSyncMessage>;
+/// Drone j's own airframe, the wire form of teammate::AirframeDescription
+/// (teammate/airframe.h has the meaning of each field), sent every few
+/// seconds (swarm.experimental.airframe_period_s): what a teammate needs to
+/// detect j and to place j's body origin behind the returns it sees
+/// (docs/teammate.md "Airframes"). Lengths travel in millimetre steps.
+struct AirframeMessage {
+  int sender_id = 0;
+  int64_t stamp_ns = 0;        // j's clock [ns]
+  int reflector_shape = 0;     // teammate::ReflectorShape as its integer, 0..2
+  Eigen::Vector3d reflector_half_extents_m = Eigen::Vector3d::Zero();    // [m], >= 0
+  Eigen::Vector3d reflector_centre_in_body_m = Eigen::Vector3d::Zero();  // [m]
+  double depth_offset_m = 0.0;    // [m]
+  double size_m = 0.0;            // [m]
+  double min_intensity = 0.0;     // Livox 0-255
+  double centroid_sigma_m = 0.0;  // [m]
+};
+
+using SwarmMessage =
+    std::variant<EgoStateMessage, GlobalExtrinsicMessage, TimeSyncMessage, AirframeMessage>;
 
 MessageType TypeOf(const SwarmMessage& message);
 int SenderOf(const SwarmMessage& message);

@@ -30,6 +30,7 @@
 
 #include "swarmlio/common/time.h"
 #include "swarmlio/common/status.h"
+#include "swarmlio/teammate/airframe.h"
 #include "swarmlio/teammate/clustering.h"
 #include "swarmlio/teammate/observation.h"
 #include "swarmlio/teammate/odometry_history.h"
@@ -94,6 +95,16 @@ class TeammateDetector {
   /// Stores a teammate's broadcast (stamp in this drone's clock).
   void AddTeammateOdometry(const TeammateOdometry& odometry);
 
+  /// A teammate's announced airframe (docs/teammate.md "Airframes"): from
+  /// now on the reflectivity and size gates admit its body (the lowest
+  /// announced min_intensity and the largest size_m, never stricter than the
+  /// options), and its observations place its body origin by its reflector
+  /// model and add its centroid scatter to the covariance. Ignores its own id
+  /// and invalid descriptions (false).
+  bool SetTeammateAirframe(int drone_id, const AirframeDescription& airframe);
+  /// The reflectivity threshold in force (the options' or lower, above).
+  double min_reflectivity() const { return clusterer_.options().min_reflectivity; }
+
   /// Processes one scan. `stamp_ns`: the time of the points' body frame and of
   /// `T_Gi_bi` (the scan end after motion compensation). Errors: non-finite
   /// pose or stamp.
@@ -147,8 +158,12 @@ class TeammateDetector {
                               const Eigen::Vector3d& center_in_b, double radius_m, double gate_m,
                               PointCluster* cluster, ScanResult* result);
 
+  // The announced airframe of `drone_id`, or null.
+  const AirframeDescription* AirframeOf(int drone_id) const;
+
   int self_id_;
   TeammateDetectorOptions options_;
+  std::map<int, AirframeDescription> airframes_;  // announced, by drone id
   ReflectiveClusterer clusterer_;
   std::map<int, OdometryHistory> odometry_;  // by drone id
   std::vector<TemporaryTracker> temporary_;
