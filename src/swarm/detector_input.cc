@@ -9,9 +9,10 @@
 namespace swarmlio::swarm::internal {
 Status DetectorInput::Make(const LidarScan& raw, int64_t t_k, const std::vector<lio::ImuPose>& poses,
                            const SwarmState& x, const teammate::ScanResult& last_detection,
-                           int64_t last_detection_ns, std::vector<teammate::ScanPoint>* points) {
+                           int64_t last_detection_ns, double min_reflectivity,
+                           std::vector<teammate::ScanPoint>* points) {
   const Eigen::Matrix3d R_imu_lidar = lidar_.QuaternionImuLidar().toRotationMatrix();
-  Select(raw, t_k, x, last_detection, last_detection_ns, R_imu_lidar);
+  Select(raw, t_k, x, last_detection, last_detection_ns, min_reflectivity, R_imu_lidar);
   SWARMLIO_RETURN_IF_ERROR(
       lio::UndistortScan(selected_, poses, R_imu_lidar, lidar_.p_lidar_in_imu_m, &undistorted_));
   const double end_offset_s = ToSeconds(t_k - raw.stamp_ns);
@@ -28,9 +29,9 @@ Status DetectorInput::Make(const LidarScan& raw, int64_t t_k, const std::vector<
 
 void DetectorInput::Select(const LidarScan& raw, int64_t t_k, const SwarmState& x,
                            const teammate::ScanResult& last_detection, int64_t last_detection_ns,
-                           const Eigen::Matrix3d& R_imu_lidar) {
+                           double min_reflectivity, const Eigen::Matrix3d& R_imu_lidar) {
   const teammate::TeammateDetectorOptions& d = detector_;
-  const float min_reflectivity = static_cast<float>(d.clustering.min_reflectivity);
+  const float threshold = static_cast<float>(min_reflectivity);
   // Trackers of the last scan, predicted to t_k, in the body frame. The body
   // moves during the scan and the prediction is rough: a generous margin.
   constexpr double kMarginM = 1.0;
@@ -50,7 +51,7 @@ void DetectorInput::Select(const LidarScan& raw, int64_t t_k, const SwarmState& 
   selected_.frame_id = raw.frame_id;
   selected_.points.clear();
   for (const LidarPoint& p : raw.points) {
-    bool keep = p.reflectivity >= min_reflectivity;
+    bool keep = p.reflectivity >= threshold;
     if (!keep) {
       const Eigen::Vector3f q(p.x, p.y, p.z);
       for (const Eigen::Vector3f& c : centers_in_lidar) {

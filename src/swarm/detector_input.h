@@ -27,17 +27,19 @@ class DetectorInput {
 
   /// The detector's points of `raw` (t_k: its end, `poses`: propagated over
   /// it), given the predicted state `x` and the trackers of the last
-  /// detection (made at last_detection_ns).
+  /// detection (made at last_detection_ns). `min_reflectivity`: the
+  /// detector's threshold in force (teammates' airframes may lower it).
   Status Make(const LidarScan& raw, int64_t t_k, const std::vector<lio::ImuPose>& poses,
               const SwarmState& x, const teammate::ScanResult& last_detection,
-              int64_t last_detection_ns, std::vector<teammate::ScanPoint>* points);
+              int64_t last_detection_ns, double min_reflectivity,
+              std::vector<teammate::ScanPoint>* points);
 
  private:
   // The raw points the detector needs: tape returns and points near the
   // trackers of the last scan (predicted to t_k).
   void Select(const LidarScan& raw, int64_t t_k, const SwarmState& x,
               const teammate::ScanResult& last_detection, int64_t last_detection_ns,
-              const Eigen::Matrix3d& R_imu_lidar);
+              double min_reflectivity, const Eigen::Matrix3d& R_imu_lidar);
 
   teammate::TeammateDetectorOptions detector_;
   SwarmOptions swarm_;

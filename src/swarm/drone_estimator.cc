@@ -176,7 +176,8 @@ Status DroneEstimator::FrontEnd(lio::ScanContext* scan, lio::UpdateRequest* requ
   // scan's reflective points at full resolution. The trackers read T_Gi_Gj
   // from the state (its one owner).
   SWARMLIO_RETURN_IF_ERROR(p.detector_input.Make(scan->raw, t_k, *scan->poses, x, p.detection,
-                                                 p.last_detection_ns, &p.points));
+                                                 p.last_detection_ns,
+                                                 detector_->min_reflectivity(), &p.points));
   p.report.detector_points = static_cast<int>(p.points.size());
   for (int id : x.layout().teammate_ids()) {
     detector_->SetGlobalExtrinsic(id, x.teammate(id).T_Ga_Gb());

@@ -24,7 +24,7 @@ Eigen::Vector3d TapeCentroidInBody(const Eigen::Vector3d& u_in_bj, double a, dou
 }
 
 ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptions& options,
-                             const Eigen::Matrix3d* R_bi_bj) {
+                             const Eigen::Matrix3d* R_bi_bj, const AirframeDescription* airframe) {
   ClusterCentre centre;
   const bool tape_only = cluster.num_reflective_points >= options.min_reflective_points;
   if (tape_only) {
@@ -36,7 +36,11 @@ ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptio
   }
   const double range = centre.p_in_b.norm();
   if (range <= 0.0) return centre;
-  if (tape_only && options.UsesTapeBand() && R_bi_bj != nullptr) {
+  if (tape_only && airframe != nullptr && R_bi_bj != nullptr) {
+    const Eigen::Vector3d u_in_bj = R_bi_bj->transpose() * (-centre.p_in_b / range);
+    centre.p_in_b -= *R_bi_bj * (airframe->reflector_centre_in_body_m +
+                                 VisibleReflectorCentroid(*airframe, u_in_bj));
+  } else if (tape_only && options.UsesTapeBand() && R_bi_bj != nullptr) {
     const Eigen::Vector3d u_in_bj = R_bi_bj->transpose() * (-centre.p_in_b / range);
     centre.p_in_b -= *R_bi_bj * TapeCentroidInBody(u_in_bj, options.tape_half_length_m,
                                                   options.tape_half_width_m);
@@ -49,17 +53,21 @@ ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptio
 TeammateObservation MakeObservation(int drone_id, int64_t stamp_ns, const PointCluster& cluster,
                                     const Eigen::Vector3d& v_bj_in_bi,
                                     const ObservationOptions& options,
-                                    const Eigen::Matrix3d* R_bi_bj) {
+                                    const Eigen::Matrix3d* R_bi_bj,
+                                    const AirframeDescription* airframe) {
   TeammateObservation out;
   out.drone_id = drone_id;
   out.stamp_ns = stamp_ns;
   out.num_points = cluster.num_points;
-  const ClusterCentre centre = EstimateCentre(cluster, options, R_bi_bj);
+  const ClusterCentre centre = EstimateCentre(cluster, options, R_bi_bj, airframe);
   out.capture_offset_s = centre.time_offset_s;
   Eigen::Vector3d p = centre.p_in_b;
   if (options.compensate_target_motion) p -= v_bj_in_bi * centre.time_offset_s;
   out.p_bj_in_bi = p;
   out.covariance_m2 = ObservationCovariance(p, options);
+  if (airframe != nullptr) {
+    out.covariance_m2.diagonal().array() += airframe->centroid_sigma_m * airframe->centroid_sigma_m;
+  }
   return out;
 }
 

@@ -27,6 +27,27 @@ TeammateDetector::TeammateDetector(int self_id, const TeammateDetectorOptions& o
 
 TeammateDetector::~TeammateDetector() = default;
 
+bool TeammateDetector::SetTeammateAirframe(int drone_id, const AirframeDescription& airframe) {
+  if (drone_id == self_id_ || drone_id < 0 || !airframe.Validate().empty()) return false;
+  airframes_[drone_id] = airframe;
+  // The gates admit every announced body; the options stay the floor.
+  // Clusters of a body's returns span at most its size plus the range noise.
+  constexpr double kSizeMargin = 1.2;
+  double min_reflectivity = options_.clustering.min_reflectivity;
+  double max_size_m = options_.clustering.max_object_size_m;
+  for (const auto& [id, a] : airframes_) {
+    min_reflectivity = std::min(min_reflectivity, a.min_intensity);
+    max_size_m = std::max(max_size_m, kSizeMargin * a.size_m);
+  }
+  clusterer_.SetGates(min_reflectivity, max_size_m);
+  return true;
+}
+
+const AirframeDescription* TeammateDetector::AirframeOf(int drone_id) const {
+  const auto it = airframes_.find(drone_id);
+  return it == airframes_.end() ? nullptr : &it->second;
+}
+
 void TeammateDetector::AddTeammateOdometry(const TeammateOdometry& odometry) {
   if (odometry.drone_id == self_id_ || odometry.drone_id < 0) return;
   if (!odometry.p_bj_in_Gj.allFinite() || !odometry.v_bj_in_Gj.allFinite()) {
@@ -104,16 +125,18 @@ void TeammateDetector::TrackTeammates(int64_t stamp_ns, const Eigen::Isometry3d&
     // The teammate's attitude relative to mine, from its broadcast through
     // T_Gi_Gj, places the body origin behind the tape (observation.h, only
     // with the band model configured).
+    const AirframeDescription* airframe = AirframeOf(id);
     Eigen::Quaterniond q_Gj_bj;
     Eigen::Matrix3d R_bi_bj;
     const bool attitude_known =
-        options_.observation.UsesTapeBand() &&
+        (airframe != nullptr || options_.observation.UsesTapeBand()) &&
         history.AttitudeAt(stamp_ns, options_.teammate.max_odometry_age_s, &q_Gj_bj);
     if (attitude_known) {
       R_bi_bj = T_Gi_bi.linear().transpose() * tracker.R_Gi_Gj() * q_Gj_bj.toRotationMatrix();
     }
     const Eigen::Matrix3d* R_bi_bj_known = attitude_known ? &R_bi_bj : nullptr;
-    const ClusterCentre centre = EstimateCentre(cluster, options_.observation, R_bi_bj_known);
+    const ClusterCentre centre =
+        EstimateCentre(cluster, options_.observation, R_bi_bj_known, airframe);
     tracker.UpdateLidar(stamp_ns + ToNanoseconds(centre.time_offset_s), T_Gi_bi * centre.p_in_b, history,
                         options_.teammate);
     Eigen::Vector3d v_in_Gi = tracker.filter().v();
@@ -121,7 +144,8 @@ void TeammateDetector::TrackTeammates(int64_t stamp_ns, const Eigen::Isometry3d&
     if (cluster.centroid_in_b.norm() >= options_.observation.min_range_m) {
       result->observations.push_back(MakeObservation(id, stamp_ns, cluster,
                                                      T_Gi_bi.linear().transpose() * v_in_Gi,
-                                                     options_.observation, R_bi_bj_known));
+                                                     options_.observation, R_bi_bj_known,
+                                                     airframe));
     }
     seen_teammates_.push_back(id);
   }

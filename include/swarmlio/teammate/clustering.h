@@ -73,6 +73,13 @@ class ReflectiveClusterer {
   ReflectiveClusterer& operator=(const ReflectiveClusterer&) = delete;
 
   const ClusteringOptions& options() const { return options_; }
+  /// Moves the two gates a teammate's announced airframe widens
+  /// (TeammateDetector::SetTeammateAirframe); both must be finite and the
+  /// size positive.
+  void SetGates(double min_reflectivity, double max_object_size_m) {
+    options_.min_reflectivity = min_reflectivity;
+    options_.max_object_size_m = max_object_size_m;
+  }
 
   /// True if a cluster's size is plausible for a drone.
   bool IsDroneSized(const PointCluster& cluster) const {

@@ -35,6 +35,7 @@
 #include <string>
 
 #include "swarmlio/common/option_fields.h"
+#include "swarmlio/teammate/airframe.h"
 #include "swarmlio/teammate/scan_types.h"
 
 namespace swarmlio::teammate {
@@ -100,13 +101,16 @@ struct TeammateObservation {
 /// centroid with the depth correction) and the time it refers to (relative
 /// to the scan stamp). `R_bi_bj`: the object's attitude relative to the
 /// observer when known (an identified teammate), for the band model of the
-/// file comment; null: the constant offset.
+/// file comment; null: the constant offset. `airframe`: the teammate's
+/// announced body (teammate/airframe.h); with `R_bi_bj` its reflector model
+/// replaces the options' band and offset.
 struct ClusterCentre {
   Eigen::Vector3d p_in_b = Eigen::Vector3d::Zero();
   double time_offset_s = 0.0;
 };
 ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptions& options,
-                             const Eigen::Matrix3d* R_bi_bj = nullptr);
+                             const Eigen::Matrix3d* R_bi_bj = nullptr,
+                             const AirframeDescription* airframe = nullptr);
 
 /// The tape centroid relative to the body origin, in b_j, for a band of half
 /// extents a (x) and b (y) seen from the unit direction `u_in_bj` (teammate ->
@@ -115,10 +119,12 @@ Eigen::Vector3d TapeCentroidInBody(const Eigen::Vector3d& u_in_bj, double a, dou
 
 /// Builds the observation of `cluster` (in b_i at `stamp_ns`). `v_bj_in_bi`:
 /// the teammate's velocity (in G_i) rotated into b_i, for the time correction.
+/// `airframe`: as EstimateCentre; its centroid scatter adds to the covariance.
 TeammateObservation MakeObservation(int drone_id, int64_t stamp_ns, const PointCluster& cluster,
                                     const Eigen::Vector3d& v_bj_in_bi,
                                     const ObservationOptions& options,
-                                    const Eigen::Matrix3d* R_bi_bj = nullptr);
+                                    const Eigen::Matrix3d* R_bi_bj = nullptr,
+                                    const AirframeDescription* airframe = nullptr);
 
 /// The observation covariance at `p_in_b` (see the file comment).
 Eigen::Matrix3d ObservationCovariance(const Eigen::Vector3d& p_in_b,
