@@ -28,6 +28,7 @@ struct DroneEntry {
   lio::OdometryOptions odometry;
   teammate::TeammateDetectorOptions teammate;
   swarm::SwarmOptions swarm;
+  teammate::AirframeDescription airframe;
   TrueClock true_clock;
   double start_offset_s = 0.0;
   double restart_at_s = 0.0;
@@ -57,6 +58,7 @@ struct DroneEntry {
     v("odometry", odometry);
     v("teammate", teammate);
     v("swarm", swarm);
+    v("airframe", airframe);
     v("true_clock", true_clock);
     v("start_offset_s", start_offset_s,
       FieldSpec::InRange(0.0, 1e6, "s",
@@ -160,6 +162,7 @@ Status ParseManifest(const std::string& yaml_text, const std::string& name,
     d.ground_truth_frame = e.ground_truth_frame;
     if (!e.teammate_returns.empty()) d.teammate_returns_path = Resolve(folder, e.teammate_returns);
     d.bag = e.bag_topics;
+    d.airframe = e.airframe;
     d.true_clock = e.true_clock;
     d.start_offset_s = e.start_offset_s;
     d.restart_at_s = e.restart_at_s;

@@ -8,6 +8,7 @@
 #include "swarmlio/common/check.h"
 #include "swarmlio/config/dump_options.h"
 #include "swarmlio/math/so3.h"
+#include "swarmlio/sim/airframe_description.h"
 
 namespace swarmlio::sim {
 namespace {
@@ -130,6 +131,8 @@ std::string ReplayManifestYaml(const Scenario& s, const Simulator& sim) {
     os << "    # the drone's clock (truth, for packet delivery in the replay only)\n";
     os << "    true_clock: {offset_s: " << d.clock_offset_s << ", drift_ppm: " << d.clock_drift_ppm
        << ", origin_s: " << sim.config().stamp_origin_s << "}\n";
+    os << "    # the airframe as its owner describes it (announced to the teammates)\n";
+    os << Indented(config::DumpOptions(DescribeAirframe(d.body), "airframe"), "    ");
     os << Indented(config::DumpOptions(lidar, "lidar"), "    ");
     os << Indented(config::DumpOptions(d.imu.sensor, "imu"), "    ");
     os << "    odometry:\n";

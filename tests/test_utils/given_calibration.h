@@ -7,13 +7,14 @@
 #pragma once
 
 #include "swarmlio/driver/manifest.h"
+#include "swarmlio/sim/airframe_description.h"
 #include "swarmlio/sim/simulator.h"
 
 namespace swarmlio::testing {
 
 /// Drone `d`'s name, LiDAR (the given extrinsic), IMU, bag reading options
 /// and odometry options (the defaults for those sensors with the given IMU
-/// time offset); no bag, ground truth or clock.
+/// time offset) and its airframe as described; no bag, ground truth or clock.
 inline driver::DroneInput GivenDroneInput(const sim::DroneConfig& d) {
   driver::DroneInput input;
   input.name = d.name;
@@ -23,6 +24,7 @@ inline driver::DroneInput GivenDroneInput(const sim::DroneConfig& d) {
   input.bag.spinning_lidar = input.lidar.type == LidarType::kSpinning;
   input.odometry = driver::DefaultOdometryOptions(input.lidar, input.imu);
   input.odometry.imu_time_offset_s = sim::GivenCalibration(d).imu_time_offset_s;
+  input.airframe = sim::DescribeAirframe(d.body);
   return input;
 }
 

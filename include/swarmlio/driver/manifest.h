@@ -34,6 +34,7 @@
 #include "swarmlio/sensors/imu_options.h"
 #include "swarmlio/sensors/lidar_options.h"
 #include "swarmlio/swarm/swarm_options.h"
+#include "swarmlio/teammate/airframe.h"
 #include "swarmlio/teammate/teammate_detector_options.h"
 
 namespace swarmlio::driver {
@@ -75,6 +76,8 @@ struct DroneInput {
   lio::OdometryOptions odometry;
   teammate::TeammateDetectorOptions teammate;  // YAML `teammate:` of the drone entry
   swarm::SwarmOptions swarm;                   // YAML `swarm:` of the drone entry
+  teammate::AirframeDescription airframe;      // YAML `airframe:`: the drone's own body,
+                                               // announced to its teammates
   TrueClock true_clock;                        // simulation truth, packet delivery only
   /// The drone starts this long after its log's first record: every record
   /// before is skipped (a late join or a restart mid-flight, as
