@@ -13,6 +13,8 @@ const char* MessageTypeName(MessageType type) {
       return "GlobalExtrinsic";
     case MessageType::kTimeSync:
       return "TimeSync";
+    case MessageType::kAirframe:
+      return "Airframe";
   }
   return "unknown";
 }
@@ -25,8 +27,11 @@ MessageType TypeOf(const SwarmMessage& message) {
           return MessageType::kEgoState;
         } else if constexpr (std::is_same_v<T, GlobalExtrinsicMessage>) {
           return MessageType::kGlobalExtrinsic;
-        } else {
+        } else if constexpr (std::is_same_v<T, TimeSyncMessage>) {
           return MessageType::kTimeSync;
+        } else {
+          static_assert(std::is_same_v<T, AirframeMessage>, "a message type without a MessageType");
+          return MessageType::kAirframe;
         }
       },
       message);

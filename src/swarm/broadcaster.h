@@ -1,7 +1,8 @@
 // The per-drone component's broadcaster (docs/swarm.md "Broadcast budget",
 // docs/network.md section 2.2): after each scan, the own state with what
 // fits the byte budget of clock-sync echoes, observations of teammates and
-// repeats, and the own T_Gi_Gj estimates with gravity when new or due; the
+// repeats, the own airframe when due, and the own T_Gi_Gj estimates with
+// gravity when new or due; the
 // answers to the teammates' clock-sync requests and the own requests when
 // the driver takes the messages. Internal to src/swarm.
 #pragma once
@@ -19,6 +20,7 @@
 #include "swarmlio/swarm/broadcast_budget.h"
 #include "swarmlio/swarm/drone_estimator.h"
 #include "swarmlio/swarm/swarm_options.h"
+#include "swarmlio/teammate/airframe.h"
 #include "swarmlio/teammate/observation.h"
 #include "teammate_registry.h"
 
@@ -37,11 +39,14 @@ struct BroadcastScan {
 
 class Broadcaster {
  public:
+  /// `airframe`: this drone's own, announced every options.airframe_period_s.
   /// `clock_sync` may be null (no clock synchronisation); the pointers outlive the broadcaster.
-  Broadcaster(int self_id, const SwarmOptions& options, net::ClockSync* clock_sync,
+  Broadcaster(int self_id, const SwarmOptions& options,
+              const teammate::AirframeDescription& airframe, net::ClockSync* clock_sync,
               TeammateRegistry* registry, DroneEstimatorCounters* counters)
       : self_id_(self_id),
         options_(options),
+        airframe_(airframe),
         clock_sync_(clock_sync),
         registry_(registry),
         counters_(counters),
@@ -62,6 +67,7 @@ class Broadcaster {
   struct Pass;
   // The steps of Broadcast, in priority order (broadcaster.cc's header).
   void MakeState(Pass* pass);
+  void AnnounceAirframe(int64_t t_k);
   void AddEchoes(net::ClockSync::EchoSelection selection, int most, Pass* pass);
   void ChooseNewExtrinsics(Pass* pass);
   void SortObservations(Pass* pass);
@@ -77,6 +83,7 @@ class Broadcaster {
 
   int self_id_;
   SwarmOptions options_;
+  teammate::AirframeDescription airframe_;
   net::ClockSync* clock_sync_;
   TeammateRegistry* registry_;
   DroneEstimatorCounters* counters_;
@@ -87,6 +94,8 @@ class Broadcaster {
   SendRotation extrinsic_rotation_;
   int64_t last_extrinsic_broadcast_ns_ = 0;
   bool broadcast_extrinsics_once_ = false;
+  int64_t last_airframe_ns_ = 0;
+  bool airframe_announced_ = false;
   // This scan's observations to send again with the next state message
   // (SwarmOptions::repeat_observations), in G_i; age_ns unset.
   std::vector<net::PastObservation> repeat_;

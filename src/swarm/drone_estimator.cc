@@ -32,7 +32,7 @@ struct DroneEstimator::Parts {
         active(o.swarm, &registry, &detection.observations, counters),
         passive(o.swarm, &registry, counters),
         gravity(o.swarm, counters),
-        broadcaster(self_id, o.swarm, clock_sync.get(), &registry, counters),
+        broadcaster(self_id, o.swarm, o.airframe, clock_sync.get(), &registry, counters),
         inbox(self_id, o.swarm,
               {&registry, &passive, &gravity, &broadcaster, detector, clock_sync.get(), counters}),
         detector_input(o.teammate, o.swarm, lidar) {}
@@ -63,6 +63,7 @@ std::string DroneEstimatorOptions::Validate() const {
   if (std::string e = odometry.Validate(); !e.empty()) return "odometry." + e;
   if (std::string e = teammate.Validate(); !e.empty()) return "teammate." + e;
   if (std::string e = swarm.Validate(); !e.empty()) return "swarm." + e;
+  if (std::string e = airframe.Validate(); !e.empty()) return "airframe." + e;
   return "";
 }
 

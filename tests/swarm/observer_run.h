@@ -118,6 +118,10 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
                                                                e->echoes.size(),
                                                                e->offset_report.has_value()));
       }
+      if (const auto* a = std::get_if<net::AirframeMessage>(&m)) {
+        ++airframe_messages_sent;
+        wire_bytes.emplace_back(a->stamp_ns, kIpUdpBytes + net::AirframePacketBytes());
+      }
       if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&m)) {
         ++extrinsic_messages_sent;
         wire_bytes.emplace_back(g->stamp_ns,
@@ -143,6 +147,7 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
   int observations_sent = 0;        // in the states
   std::vector<std::pair<int64_t, size_t>> wire_bytes;  // (stamp, bytes on the wire) per message
   int extrinsic_messages_sent = 0;  // the own T_Gi_Gj, about once a second once identified
+  int airframe_messages_sent = 0;   // the own airframe, every airframe_period_s
   std::vector<int64_t> teammate_entry_stamps;  // broadcasts with the teammate's entry
   double restart_at_s = 1e9;  // the teammate reboots then (new session_start)
   double mutual_at_s = 1e9;   // from then on the teammate sends its T_Gj_Gi (it identified us)

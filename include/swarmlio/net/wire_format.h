@@ -1,4 +1,4 @@
-// The swarm packet wire format, version 5 (docs/network.md, "Wire format").
+// The swarm packet wire format, version 7 (docs/network.md, "Wire format").
 //
 //   offset size field
 //   0      1    magic 'S' (0x53)
@@ -27,8 +27,8 @@ inline constexpr uint8_t kMagic = 0x53;  // 'S'
 /// 2: gravity in GlobalExtrinsic; 3: quantized payloads, 6-byte header, 16-byte tag;
 /// 4: past observations at the end of EgoState; 5: send delay and state echoes in
 /// EgoState (clock synchronisation without TimeSync packets); 6: an optional clock
-/// offset report after the echoes.
-inline constexpr uint8_t kProtocolVersion = 6;
+/// offset report after the echoes; 7: the Airframe message (type 4).
+inline constexpr uint8_t kProtocolVersion = 7;
 inline constexpr size_t kHeaderBytes = 6;
 inline constexpr size_t kTagBytes = 16;  // HMAC-SHA512-256 truncated to 128 bits
 inline constexpr size_t kPacketOverheadBytes = kHeaderBytes + kTagBytes;
@@ -127,6 +127,19 @@ inline constexpr size_t kGlobalExtrinsicFixedBytes = 8 + 12 + CovarianceBytes(3)
 inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 6 + 12 + CovarianceBytes(6);
 // TimeSync: target id u8 | kind u8 (0 request, 1 response) | t1 t2 t3 i64
 inline constexpr size_t kTimeSyncBytes = 1 + 1 + 3 * 8;
+// Airframe (version 7): stamp i64 | reflector shape u8 (0 band, 1 box, 2 round) |
+//   min intensity u8 | reflector half extents 3 x u16 (1 mm) |
+//   reflector centre in body 3 x i16 (1 mm) | depth offset u16 (1 mm) |
+//   size u16 (1 mm) | centroid sigma u16 (1 mm)
+// Lengths: code = round(x / kAirframeLengthStepM); non-negative ones as
+// uint16 (0..65.535 m), the centre as int16 (+-32.767 m, the code -32768
+// rejected); min intensity: round(x), 0..255.
+inline constexpr double kAirframeLengthStepM = 0.001;
+inline constexpr int kAirframeLengthMaxCode = 65535;
+inline constexpr int kAirframeCentreMaxCode = 32767;
+inline constexpr int kAirframeMaxShape = 2;
+inline constexpr int kAirframeMaxIntensity = 255;
+inline constexpr size_t kAirframeBytes = 8 + 1 + 1 + 6 + 6 + 2 + 2 + 2;
 
 constexpr size_t EgoStatePacketBytes(size_t num_observations, size_t num_past_observations = 0,
                                      size_t num_echoes = 0, bool offset_report = false) {
@@ -139,6 +152,7 @@ constexpr size_t GlobalExtrinsicPacketBytes(size_t num_entries) {
   return kPacketOverheadBytes + kGlobalExtrinsicFixedBytes + kExtrinsicEntryBytes * num_entries;
 }
 constexpr size_t TimeSyncPacketBytes() { return kPacketOverheadBytes + kTimeSyncBytes; }
+constexpr size_t AirframePacketBytes() { return kPacketOverheadBytes + kAirframeBytes; }
 
 static_assert(kEgoStateFixedBytes == 66 && kObservationBytes == 13 &&
                   kPastObservationBytes == 15 && kStateEchoBytes == 7,
@@ -152,6 +166,7 @@ static_assert(EgoStateMessage::kMaxEchoes <= kEchoCountMask, "the echo count tra
 static_assert(EgoStateMessage::kMaxPastObservations <= 255, "the past count travels in one byte");
 static_assert(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries) <= kMaxPacketBytes);
 static_assert(TimeSyncPacketBytes() <= kMaxPacketBytes);
+static_assert(kAirframeBytes == 28, "layout changed: update docs");
 static_assert(EgoStateMessage::kMaxObservations < 32, "the count travels in 5 bits");
 static_assert(kMaxSwarmSize <= 255, "ids travel as one byte");
 

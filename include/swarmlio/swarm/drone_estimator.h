@@ -39,6 +39,7 @@
 #include "swarmlio/sensors/lidar_options.h"
 #include "swarmlio/swarm/sensor_record.h"
 #include "swarmlio/swarm/swarm_options.h"
+#include "swarmlio/teammate/airframe.h"
 #include "swarmlio/teammate/teammate_detector.h"
 
 namespace swarmlio::swarm {
@@ -47,6 +48,9 @@ struct DroneEstimatorOptions {
   lio::OdometryOptions odometry;
   teammate::TeammateDetectorOptions teammate;
   SwarmOptions swarm;
+  /// This drone's own body, announced to the teammates every
+  /// swarm.experimental.airframe_period_s (YAML `airframe:` of a drone entry).
+  teammate::AirframeDescription airframe;
   std::string Validate() const;
 };
 
@@ -90,7 +94,8 @@ struct DroneOutput {
 
 struct DroneEstimatorCounters {
   int64_t messages_received = 0;
-  int64_t messages_ignored = 0;   // own, unknown type, non-finite, stale, or a TimeSync for another drone
+  int64_t messages_ignored = 0;   // own, unknown type, non-finite, stale, a TimeSync for another
+                                  // drone, or an invalid airframe
   int64_t teammate_restarts = 0;  // session_start changed
   int64_t messages_unsynchronized = 0;  // states of a teammate whose clock offset is not known yet
   int64_t identifications = 0;
@@ -112,11 +117,12 @@ struct DroneEstimatorCounters {
   int64_t sent_observation_bytes = 0;
   int64_t sent_repeat_bytes = 0;
   int64_t sent_extrinsic_bytes = 0;
+  int64_t sent_airframe_bytes = 0;  // the own airframe's announcements
   int64_t observations_unsent = 0;
 };
 
 /// One line for the tools' summaries: "broadcast: N B states, ... B
-/// extrinsics" (the sent_* counters and observations_unsent), starting with
+/// extrinsics, ... B airframe" (the sent_* counters and observations_unsent), starting with
 /// `indent`, ending with a newline.
 std::string FormatBroadcastCounters(const DroneEstimatorCounters& c, const std::string& indent);
 

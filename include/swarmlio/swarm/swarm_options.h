@@ -135,6 +135,11 @@ struct SwarmOptions {
   /// The own T_Gi_Gj estimates are broadcast this often (0 = never) [s];
   /// new ones at once. Entries per broadcast: broadcast_budget.
   double extrinsic_broadcast_period_s = 1.0;
+  /// This drone's airframe (DroneEstimatorOptions::airframe) is announced to
+  /// the teammates with the first scan's messages and then this often, on
+  /// the own clock (0 = never: teammates detect it with their own defaults).
+  /// 50 B per packet, paid from the byte budget like the state [s].
+  double airframe_period_s = 2.0;
   /// The bytes this drone puts on the wire: a budget shared by the optional
   /// content of its messages (docs/swarm.md "Broadcast budget").
   BroadcastBudgetOptions broadcast_budget;
@@ -191,6 +196,8 @@ struct SwarmOptions {
                        "its block was fused graph_derived_min_observations times"));
       x("graph_derived_min_observations", graph_derived_min_observations,
         FieldSpec::AtLeast(0, "", "own observations fused into a graph-derived block before it may relay"));
+      x("airframe_period_s", airframe_period_s,
+        FieldSpec::InRange(0.0, 3600.0, "s", "announce the own airframe this often (0 = never)"));
     });
   }
   std::string Validate() const { return config::ValidateFields(*this); }
