@@ -43,8 +43,9 @@ Status DecodeAirframe(int sender_id, PacketReader* r, AirframeMessage* out) {
   uint8_t intensity = 0;
   SWARMLIO_RETURN_IF_ERROR(r->U8("reflector_shape", &shape));
   if (shape > kAirframeMaxShape) {
-    return r->Invalid("reflector_shape", -1,
-                      "has the unknown value " + std::to_string(shape) + " (0 band, 1 box, 2 round)");
+    return r->Invalid(
+        "reflector_shape", -1,
+        "has the unknown value " + std::to_string(shape) + " (0 band, 1 box, 2 round)");
   }
   m.reflector_shape = shape;
   SWARMLIO_RETURN_IF_ERROR(r->U8("min_intensity", &intensity));

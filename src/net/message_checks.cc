@@ -102,7 +102,8 @@ class Checker {
                            kAirframeLengthStepM;
       Fail(field, index,
            "= " + std::to_string(v) + " m is outside the wire range " +
-               (may_be_negative ? "+-" + std::to_string(max_m) : "[0, " + std::to_string(max_m) + "]") +
+               (may_be_negative ? "+-" + std::to_string(max_m)
+                                : "[0, " + std::to_string(max_m) + "]") +
                " m");
     }
   }
@@ -245,16 +246,16 @@ Status Check(const EgoStateMessage& m) {
     const StateEcho& e = m.echoes[i];
     c.TeammateId("teammate_id", e.teammate_id, m.sender_id, &seen_echo);
     if (e.send_delay_ns < 0 || SyncDelayCode(e.send_delay_ns) > kSendDelayMaxCode) {
-      c.Fail("send_delay_ns", -1,
-             "= " + std::to_string(e.send_delay_ns) + " is outside " +
-                 delay_range(kSendDelayMaxCode));
+      c.Fail(
+          "send_delay_ns", -1,
+          "= " + std::to_string(e.send_delay_ns) + " is outside " + delay_range(kSendDelayMaxCode));
     }
     int64_t hold_ns = 0;
     if (!StateEchoHoldNs(m.stamp_ns, m.send_delay_ns, e.arrival_ns, &hold_ns) || hold_ns < 0 ||
         SyncDelayCode(hold_ns) > kHoldMaxCode) {
       c.Fail("arrival_ns", -1,
-             "= " + std::to_string(e.arrival_ns) +
-                 ": the hold (send time - arrival) is outside " + delay_range(kHoldMaxCode));
+             "= " + std::to_string(e.arrival_ns) + ": the hold (send time - arrival) is outside " +
+                 delay_range(kHoldMaxCode));
     }
   }
   return c.status();

@@ -42,8 +42,11 @@ int SenderOf(const SwarmMessage& message) {
 }
 
 std::vector<GlobalExtrinsicMessage> SplitGlobalExtrinsics(
-    int sender_id, int64_t stamp_ns, const std::vector<GlobalExtrinsicEntry>& entries,
-    const Eigen::Vector3d& g_in_Gi, const Eigen::Matrix3d& cov_g_in_Gi) {
+    int sender_id,
+    int64_t stamp_ns,
+    const std::vector<GlobalExtrinsicEntry>& entries,
+    const Eigen::Vector3d& g_in_Gi,
+    const Eigen::Matrix3d& cov_g_in_Gi) {
   std::vector<GlobalExtrinsicMessage> messages;
   size_t begin = 0;
   do {

@@ -8,7 +8,8 @@ static_assert(static_cast<int>(teammate::ReflectorShape::kBand) == 0 &&
                   static_cast<int>(teammate::ReflectorShape::kRound) == 2,
               "the wire's reflector shape codes are 0 band, 1 box, 2 round");
 
-net::AirframeMessage ToAirframeMessage(int sender_id, int64_t stamp_ns,
+net::AirframeMessage ToAirframeMessage(int sender_id,
+                                       int64_t stamp_ns,
                                        const teammate::AirframeDescription& airframe) {
   net::AirframeMessage m;
   m.sender_id = sender_id;

@@ -13,7 +13,8 @@
 namespace swarmlio::swarm::internal {
 
 /// Drone `sender_id`'s announcement of `airframe` at `stamp_ns` (its clock).
-net::AirframeMessage ToAirframeMessage(int sender_id, int64_t stamp_ns,
+net::AirframeMessage ToAirframeMessage(int sender_id,
+                                       int64_t stamp_ns,
                                        const teammate::AirframeDescription& airframe);
 
 /// The description a teammate announced; false (and `airframe` untouched)

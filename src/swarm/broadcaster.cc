@@ -32,6 +32,8 @@
 // not fit is skipped and the smaller items after it take what is left. An
 // item that does not fit waits: a later scan, with more credit or fewer
 // teammates in view, sends it.
+#include "broadcaster.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <limits>
@@ -41,7 +43,6 @@
 #include <vector>
 
 #include "airframe_message.h"
-#include "broadcaster.h"
 #include "swarmlio/common/time.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/net/wire_format.h"
@@ -64,12 +65,14 @@ size_t ExtrinsicWireBytes(const BroadcastBudget& budget, size_t n) {
 // Overdue T_Gi_Gj entries may take at most this share of the byte budget.
 constexpr double kOverdueBudgetShare = 0.1;
 
-bool ChooseExtrinsicEntries(const std::vector<int>& candidates, int max_entries,
-                            BroadcastBudget* budget, std::vector<int>* chosen) {
+bool ChooseExtrinsicEntries(const std::vector<int>& candidates,
+                            int max_entries,
+                            BroadcastBudget* budget,
+                            std::vector<int>* chosen) {
   for (int id : candidates) {
     if (max_entries > 0 && static_cast<int>(chosen->size()) >= max_entries) return true;
-    const size_t extra =
-        ExtrinsicWireBytes(*budget, chosen->size() + 1) - ExtrinsicWireBytes(*budget, chosen->size());
+    const size_t extra = ExtrinsicWireBytes(*budget, chosen->size() + 1) -
+                         ExtrinsicWireBytes(*budget, chosen->size());
     if (!budget->TrySpend(extra)) return false;
     chosen->push_back(id);
   }
@@ -80,15 +83,15 @@ bool ChooseExtrinsicEntries(const std::vector<int>& candidates, int max_entries,
 
 std::string FormatBroadcastCounters(const DroneEstimatorCounters& c, const std::string& indent) {
   char line[256];
-  std::snprintf(line, sizeof(line),
-                "broadcast: %lld B states, %lld B echoes, %lld B observations (%lld left out by "
-                "the byte budget), %lld B repeats, %lld B extrinsics, %lld B airframe\n",
-                static_cast<long long>(c.sent_state_bytes), static_cast<long long>(c.sent_echo_bytes),
-                static_cast<long long>(c.sent_observation_bytes),
-                static_cast<long long>(c.observations_unsent),
-                static_cast<long long>(c.sent_repeat_bytes),
-                static_cast<long long>(c.sent_extrinsic_bytes),
-                static_cast<long long>(c.sent_airframe_bytes));
+  std::snprintf(
+      line, sizeof(line),
+      "broadcast: %lld B states, %lld B echoes, %lld B observations (%lld left out by "
+      "the byte budget), %lld B repeats, %lld B extrinsics, %lld B airframe\n",
+      static_cast<long long>(c.sent_state_bytes), static_cast<long long>(c.sent_echo_bytes),
+      static_cast<long long>(c.sent_observation_bytes),
+      static_cast<long long>(c.observations_unsent), static_cast<long long>(c.sent_repeat_bytes),
+      static_cast<long long>(c.sent_extrinsic_bytes),
+      static_cast<long long>(c.sent_airframe_bytes));
   return indent + line;
 }
 
@@ -174,8 +177,8 @@ void Broadcaster::AnnounceAirframe(int64_t t_k) {
   // With the first scan's messages, then every airframe_period_s of the own
   // clock; paid whatever the credit, like the state.
   const double period = options_.airframe_period_s;
-  const bool due = period > 0.0 && (!airframe_announced_ ||
-                                    ToSeconds(t_k - last_airframe_ns_) >= period);
+  const bool due =
+      period > 0.0 && (!airframe_announced_ || ToSeconds(t_k - last_airframe_ns_) >= period);
   if (!due) return;
   const size_t bytes = budget_.WireBytes(net::AirframePacketBytes());
   budget_.Spend(bytes);
@@ -264,10 +267,12 @@ void Broadcaster::AddRepeats(Pass* pass) {
     if (!pass->send_state || pass->blocked) break;
     o.age_ns = pass->scan.t_k - repeat_stamp_ns_;
     if (o.age_ns <= 0 || net::PastObservationAgeCode(o.age_ns) > net::kPastObservationAgeMaxCode ||
-        !((o.p_bk_in_Gj - m.p_bj_in_Gj).array().abs() < 0.9 * net::kObservationPositionMaxM).all()) {
+        !((o.p_bk_in_Gj - m.p_bj_in_Gj).array().abs() < 0.9 * net::kObservationPositionMaxM)
+             .all()) {
       continue;
     }
-    if (static_cast<int>(m.past_observations.size()) >= net::EgoStateMessage::kMaxPastObservations) {
+    if (static_cast<int>(m.past_observations.size()) >=
+        net::EgoStateMessage::kMaxPastObservations) {
       break;
     }
     const size_t bytes = net::kPastObservationBytes + (m.past_observations.empty() ? 1 : 0);
@@ -360,7 +365,8 @@ void Broadcaster::SendExtrinsics(Pass* pass) {
   }
 }
 
-void Broadcaster::RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,
+void Broadcaster::RememberForRepeat(const net::EgoStateMessage& m,
+                                    const SwarmState& x,
                                     const Eigen::MatrixXd& P) {
   const RepeatObservations policy = options_.repeat_observations;
   if (policy == RepeatObservations::kNone) return;
@@ -376,7 +382,8 @@ void Broadcaster::RememberForRepeat(const net::EgoStateMessage& m, const SwarmSt
   for (const net::CurrentObservation& o : m.observations) {
     if (policy == RepeatObservations::kDegenerateTeammates) {
       const auto it = registry_->teammates().find(o.observed_id);
-      if (it == registry_->teammates().end() || !it->second.have_message || !it->second.last.degenerated) {
+      if (it == registry_->teammates().end() || !it->second.have_message ||
+          !it->second.last.degenerated) {
         continue;
       }
     }

@@ -28,11 +28,11 @@ namespace swarmlio::swarm::internal {
 
 /// What the broadcast of one scan is made of.
 struct BroadcastScan {
-  int64_t t_k = 0;                   // the scan end (own clock)
-  const SwarmState* x = nullptr;     // the posterior
+  int64_t t_k = 0;                // the scan end (own clock)
+  const SwarmState* x = nullptr;  // the posterior
   const Eigen::MatrixXd* P = nullptr;
-  bool degenerate = false;           // the scan's degeneracy flag
-  int64_t session_start_ns = 0;      // the odometry's initialization stamp
+  bool degenerate = false;                              // the scan's degeneracy flag
+  int64_t session_start_ns = 0;                         // the odometry's initialization stamp
   Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();  // the newest gyro sample [rad/s]
   const std::vector<teammate::TeammateObservation>* observations = nullptr;  // this scan's
 };
@@ -41,9 +41,12 @@ class Broadcaster {
  public:
   /// `airframe`: this drone's own, announced every options.airframe_period_s.
   /// `clock_sync` may be null (no clock synchronisation); the pointers outlive the broadcaster.
-  Broadcaster(int self_id, const SwarmOptions& options,
-              const teammate::AirframeDescription& airframe, net::ClockSync* clock_sync,
-              TeammateRegistry* registry, DroneEstimatorCounters* counters)
+  Broadcaster(int self_id,
+              const SwarmOptions& options,
+              const teammate::AirframeDescription& airframe,
+              net::ClockSync* clock_sync,
+              TeammateRegistry* registry,
+              DroneEstimatorCounters* counters)
       : self_id_(self_id),
         options_(options),
         airframe_(airframe),
@@ -78,7 +81,8 @@ class Broadcaster {
   void SendExtrinsics(Pass* pass);
   // Keeps the observations of the state message `m` that the next message
   // repeats (SwarmOptions::repeat_observations), moved into G_i.
-  void RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,
+  void RememberForRepeat(const net::EgoStateMessage& m,
+                         const SwarmState& x,
                          const Eigen::MatrixXd& P);
 
   int self_id_;

@@ -38,7 +38,8 @@ bool MessageInbox::MadeInSessionOf(int teammate_id, int sender_id, int64_t sende
   return local_ns >= it->second.session_heard_ns + margin_ns;
 }
 
-bool MessageInbox::MadeInThisSession(int sender_id, int64_t sender_stamp_ns,
+bool MessageInbox::MadeInThisSession(int sender_id,
+                                     int64_t sender_stamp_ns,
                                      const OwnSession& own) const {
   if (!own.started) return false;
   int64_t local_ns = 0;
@@ -141,7 +142,8 @@ void MessageInbox::OnState(const net::EgoStateMessage& received, int64_t arrival
     }
   }
   TeammateInfo& info = to_.registry->teammates()[m.sender_id];
-  if (info.have_message && m.session_start_ns != info.session_start_ns) OnRestart(m.sender_id, arrival_ns);
+  if (info.have_message && m.session_start_ns != info.session_start_ns)
+    OnRestart(m.sender_id, arrival_ns);
   if (info.have_message && m.stamp_ns <= info.last.stamp_ns) {
     ++to_.counters->messages_ignored;  // older than what we have (reordered)
   } else {

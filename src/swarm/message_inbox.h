@@ -6,8 +6,8 @@
 // updater; a state to the registry (the newest state, sessions and
 // restarts), the detector (the broadcast trajectory) and, for each
 // observation of this drone it carries, the passive updater; a teammate's
-// airframe to the detector. Bad or own messages are counted and ignored. An extrinsic entry's frames (the wire's
-// neutral T_Ga_Gb, a = sender) are named here, once: T_Gj_Gi or T_Gj_Gk.
+// airframe to the detector. Bad or own messages are counted and ignored. An extrinsic entry's
+// frames (the wire's neutral T_Ga_Gb, a = sender) are named here, once: T_Gj_Gi or T_Gj_Gk.
 // Internal to src/swarm.
 #pragma once
 

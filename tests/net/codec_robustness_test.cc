@@ -339,7 +339,7 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
     ExpectRejected(p, "session_start_ns' is negative");
   }
   const size_t first = kEgoFirstEcho;  // the first observation (no echoes)
-  {  // observed id out of range
+  {                                    // observed id out of range
     std::vector<uint8_t> p = ego;
     p[first] = 200;
     Resign(&p);
@@ -420,8 +420,8 @@ TEST(PacketCodecRobustness, MalformedAirframesAreRejected) {
     std::vector<uint8_t> p = airframe;
     p[kAirframeShape] = shape;
     Resign(&p);
-    ExpectRejected(p, "Airframe: field 'reflector_shape' has the unknown value " +
-                          std::to_string(shape));
+    ExpectRejected(
+        p, "Airframe: field 'reflector_shape' has the unknown value " + std::to_string(shape));
   }
   {  // a centre code of -32768 (the range is +-32767 mm)
     std::vector<uint8_t> p = airframe;

@@ -14,9 +14,9 @@ namespace {
 
 using net_test::AllExampleMessages;
 using net_test::ExpectSameMessage;
+using net_test::MakeAirframe;
 using net_test::MakeCodec;
 using net_test::MakeEgoState;
-using net_test::MakeAirframe;
 using net_test::MakeGlobalExtrinsic;
 using net_test::MakeRawAirframe;
 using net_test::MakeTimeSync;
@@ -68,12 +68,12 @@ TEST(PacketCodec, DocumentedSizes) {
   EXPECT_EQ(EgoStatePacketBytes(2), 114u);
   EXPECT_EQ(EgoStatePacketBytes(4), 140u);
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 400u);
-  EXPECT_EQ(EgoStatePacketBytes(1, 1), 117u);  // one observation, repeated in the next
-  EXPECT_EQ(EgoStatePacketBytes(1, 0, 1), 108u);  // one observation, one clock echo
+  EXPECT_EQ(EgoStatePacketBytes(1, 1), 117u);          // one observation, repeated in the next
+  EXPECT_EQ(EgoStatePacketBytes(1, 0, 1), 108u);       // one observation, one clock echo
   EXPECT_EQ(EgoStatePacketBytes(0, 0, 0, true), 92u);  // an offset report
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
-                                EgoStateMessage::kMaxPastObservations,
-                                EgoStateMessage::kMaxEchoes), 817u);
+                                EgoStateMessage::kMaxPastObservations, EgoStateMessage::kMaxEchoes),
+            817u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(0), 49u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 90u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 377u);

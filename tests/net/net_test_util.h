@@ -65,8 +65,11 @@ class ValueSource {
   std::mt19937_64 engine_;
 };
 
-inline EgoStateMessage MakeRawEgoState(int sender, int num_observations, uint64_t seed,
-                                       int num_past_observations = 0, int num_echoes = 0) {
+inline EgoStateMessage MakeRawEgoState(int sender,
+                                       int num_observations,
+                                       uint64_t seed,
+                                       int num_past_observations = 0,
+                                       int num_echoes = 0) {
   ValueSource v(seed);
   EgoStateMessage m;
   m.sender_id = sender;
@@ -174,8 +177,11 @@ Message OnTheWire(const Message& message) {
   return std::get<Message>(decoded.message);
 }
 
-inline EgoStateMessage MakeEgoState(int sender, int num_observations, uint64_t seed,
-                                    int num_past_observations = 0, int num_echoes = 0) {
+inline EgoStateMessage MakeEgoState(int sender,
+                                    int num_observations,
+                                    uint64_t seed,
+                                    int num_past_observations = 0,
+                                    int num_echoes = 0) {
   return OnTheWire(
       MakeRawEgoState(sender, num_observations, seed, num_past_observations, num_echoes));
 }
@@ -292,7 +298,8 @@ inline std::vector<SwarmMessage> AllExampleMessages() {
   messages.push_back(MakeEgoState(3, EgoStateMessage::kMaxObservations, 153,
                                   EgoStateMessage::kMaxPastObservations,
                                   EgoStateMessage::kMaxEchoes));
-  for (const auto& [echoes, std_code] : {std::pair{0, 1}, std::pair{2, ClockOffsetReport::kMaxStdCode}}) {
+  for (const auto& [echoes, std_code] :
+       {std::pair{0, 1}, std::pair{2, ClockOffsetReport::kMaxStdCode}}) {
     EgoStateMessage m = MakeEgoState(3, 1, 154, 0, echoes);  // with an offset report
     if (echoes == 0) m.send_delay_ns = 120'000;
     m.offset_report = ClockOffsetReport{63, 0xFFFE, std_code};

@@ -115,7 +115,8 @@ TEST(DroneEstimatorAirframe, AnnouncesItsOwnWithTheFirstScanAndThenEveryPeriod) 
   std::vector<std::unique_ptr<DroneEstimator>> estimators(2);
   for (int i = 0; i < 2; ++i) {
     if (i == 1) o.swarm.airframe_period_s = 0.0;  // never
-    ASSERT_TRUE(DroneEstimator::Create(0, o, sim::GivenLidarOptions(drones[0]), &estimators[i]).ok());
+    ASSERT_TRUE(
+        DroneEstimator::Create(0, o, sim::GivenLidarOptions(drones[0]), &estimators[i]).ok());
   }
   TwoComponents sink(&estimators);
   sim::DroneStats stats;
@@ -156,8 +157,8 @@ TEST(DroneEstimatorAirframe, AnnouncesItsOwnWithTheFirstScanAndThenEveryPeriod) 
   }
   EXPECT_EQ(airframe_stamps, expected);
   EXPECT_GE(airframe_stamps.size(), 2u);
-  const int64_t wire_bytes = static_cast<int64_t>(
-      net::AirframePacketBytes() + o.swarm.broadcast_budget.ip_udp_header_bytes);
+  const int64_t wire_bytes = static_cast<int64_t>(net::AirframePacketBytes() +
+                                                  o.swarm.broadcast_budget.ip_udp_header_bytes);
   EXPECT_EQ(estimators[0]->counters().sent_airframe_bytes,
             wire_bytes * static_cast<int64_t>(airframe_stamps.size()));
 

@@ -19,7 +19,9 @@ Eigen::Matrix3d Covariance3(double scale) {
   return scale * c;
 }
 
-net::EgoStateMessage EgoState(int sender, int num_observations, int num_past = 0,
+net::EgoStateMessage EgoState(int sender,
+                              int num_observations,
+                              int num_past = 0,
                               int num_echoes = 0) {
   net::EgoStateMessage m;
   m.sender_id = sender;
@@ -134,12 +136,12 @@ Status WriteFile(const std::string& path, const std::vector<uint8_t>& bytes) {
 }  // namespace
 
 std::vector<net::SwarmMessage> SeedMessages() {
-  return {EgoState(3, 0),        EgoState(3, 1),        EgoState(3, 2),
-          EgoState(7, 5),        EgoState(63, 24),      EgoState(3, 1, 1),      EgoState(3, 1, 0, 2),   EgoState(9, 24, 24, 8),
-          EgoState(9, 24, 24),   GlobalExtrinsic(5, 0),
-          GlobalExtrinsic(5, 1), GlobalExtrinsic(2, 3), GlobalExtrinsic(0, 8),
-          TimeSync(1, 2, false), TimeSync(2, 1, true),    Airframe(4, 0),
-          Airframe(63, 2)};
+  return {EgoState(3, 0),        EgoState(3, 1),         EgoState(3, 2),
+          EgoState(7, 5),        EgoState(63, 24),       EgoState(3, 1, 1),
+          EgoState(3, 1, 0, 2),  EgoState(9, 24, 24, 8), EgoState(9, 24, 24),
+          GlobalExtrinsic(5, 0), GlobalExtrinsic(5, 1),  GlobalExtrinsic(2, 3),
+          GlobalExtrinsic(0, 8), TimeSync(1, 2, false),  TimeSync(2, 1, true),
+          Airframe(4, 0),        Airframe(63, 2)};
 }
 
 Status WriteSeedCorpus(const std::string& dir) {

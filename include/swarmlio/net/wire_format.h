@@ -90,13 +90,13 @@ inline constexpr size_t kStateEchoBytes = 1 + 2 + 2 + 2;
 inline constexpr uint8_t kEchoCountMask = 0x7F;
 inline constexpr uint8_t kOffsetReportFlag = 0x80;
 inline constexpr size_t kOffsetReportBytes = 1 + 2 + 1;
-inline constexpr int64_t kOffsetReportStepNs = 1000;       // 1 us: the residue wraps at 65.536 ms
-inline constexpr int64_t kOffsetReportStdStepNs = 50000;   // 50 us: std up to 12.7 ms
+inline constexpr int64_t kOffsetReportStepNs = 1000;      // 1 us: the residue wraps at 65.536 ms
+inline constexpr int64_t kOffsetReportStdStepNs = 50000;  // 50 us: std up to 12.7 ms
 // Send delay, an echo's send delay and hold: uint16 code = round(ns / kSyncDelayStepNs).
 inline constexpr int64_t kSyncDelayStepNs = 10000;  // 10 us
 inline constexpr int kSendDelayMaxCode = 65534;     // 655.34 ms; 65535 = not known
 inline constexpr int kSendDelayUnknownCode = 65535;
-inline constexpr int kHoldMaxCode = 65535;          // 655.35 ms
+inline constexpr int kHoldMaxCode = 65535;  // 655.35 ms
 /// The code the writer sends for a send delay or hold (rounded; callers check the range).
 constexpr int64_t SyncDelayCode(int64_t ns) {
   return (ns + kSyncDelayStepNs / 2) / kSyncDelayStepNs;
@@ -105,7 +105,9 @@ constexpr int64_t SyncDelayCode(int64_t ns) {
 constexpr int64_t QuantizedSyncDelayNs(int64_t ns) { return SyncDelayCode(ns) * kSyncDelayStepNs; }
 /// The hold of an echo: the send time of the state that carries it (stamp +
 /// the quantized send delay) - the echoed state's arrival. False on overflow.
-inline bool StateEchoHoldNs(int64_t stamp_ns, int64_t send_delay_ns, int64_t arrival_ns,
+inline bool StateEchoHoldNs(int64_t stamp_ns,
+                            int64_t send_delay_ns,
+                            int64_t arrival_ns,
                             int64_t* hold_ns) {
   int64_t sent_ns = 0;
   return !__builtin_add_overflow(stamp_ns, QuantizedSyncDelayNs(send_delay_ns), &sent_ns) &&
@@ -141,11 +143,12 @@ inline constexpr int kAirframeMaxShape = 2;
 inline constexpr int kAirframeMaxIntensity = 255;
 inline constexpr size_t kAirframeBytes = 8 + 1 + 1 + 6 + 6 + 2 + 2 + 2;
 
-constexpr size_t EgoStatePacketBytes(size_t num_observations, size_t num_past_observations = 0,
-                                     size_t num_echoes = 0, bool offset_report = false) {
+constexpr size_t EgoStatePacketBytes(size_t num_observations,
+                                     size_t num_past_observations = 0,
+                                     size_t num_echoes = 0,
+                                     bool offset_report = false) {
   return kPacketOverheadBytes + kEgoStateFixedBytes + kStateEchoBytes * num_echoes +
-         (offset_report ? kOffsetReportBytes : 0) +
-         kObservationBytes * num_observations +
+         (offset_report ? kOffsetReportBytes : 0) + kObservationBytes * num_observations +
          (num_past_observations > 0 ? 1 + kPastObservationBytes * num_past_observations : 0);
 }
 constexpr size_t GlobalExtrinsicPacketBytes(size_t num_entries) {
@@ -154,14 +157,15 @@ constexpr size_t GlobalExtrinsicPacketBytes(size_t num_entries) {
 constexpr size_t TimeSyncPacketBytes() { return kPacketOverheadBytes + kTimeSyncBytes; }
 constexpr size_t AirframePacketBytes() { return kPacketOverheadBytes + kAirframeBytes; }
 
-static_assert(kEgoStateFixedBytes == 66 && kObservationBytes == 13 &&
-                  kPastObservationBytes == 15 && kStateEchoBytes == 7,
+static_assert(kEgoStateFixedBytes == 66 && kObservationBytes == 13 && kPastObservationBytes == 15 &&
+                  kStateEchoBytes == 7,
               "layout changed: update docs");
 static_assert(kGlobalExtrinsicFixedBytes == 27 && kExtrinsicEntryBytes == 41,
               "layout changed: update docs");
 static_assert(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
                                   EgoStateMessage::kMaxPastObservations,
-                                  EgoStateMessage::kMaxEchoes, true) <= kMaxPacketBytes);
+                                  EgoStateMessage::kMaxEchoes,
+                                  true) <= kMaxPacketBytes);
 static_assert(EgoStateMessage::kMaxEchoes <= kEchoCountMask, "the echo count travels in 7 bits");
 static_assert(EgoStateMessage::kMaxPastObservations <= 255, "the past count travels in one byte");
 static_assert(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries) <= kMaxPacketBytes);

@@ -57,13 +57,13 @@ struct DroneEstimatorOptions {
 /// One identified teammate's state in this drone's frame G_i at a scan end.
 struct TeammateEstimate {
   int drone_id = -1;
-  GlobalExtrinsic T_Gi_Gj;                                           // from the state
+  GlobalExtrinsic T_Gi_Gj;  // from the state
   Eigen::Matrix<double, 6, 6> extrinsic_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool have_pose = false;  // a recent enough broadcast state exists
   Eigen::Quaterniond q_Gi_bj = Eigen::Quaterniond::Identity();  // j's body in G_i
   Eigen::Vector3d p_bj_in_Gi = Eigen::Vector3d::Zero();
   Eigen::Vector3d v_bj_in_Gi = Eigen::Vector3d::Zero();
-  bool seen = false;        // a LiDAR observation of j in this scan
+  bool seen = false;             // a LiDAR observation of j in this scan
   int active_observations = 0;   // fused in this scan
   int passive_observations = 0;  // fused in this scan
 };
@@ -71,25 +71,25 @@ struct TeammateEstimate {
 /// How a teammate was identified.
 struct IdentificationEvent {
   int drone_id = -1;
-  int64_t stamp_ns = 0;       // own clock
-  std::string method;         // "trajectory_match", "teammate_match" (it identified me) or
-                              // "graph" (through teammate via_drone_id's own match)
-  int via_drone_id = -1;      // "graph": the teammate whose T_Gj_Gk was composed
+  int64_t stamp_ns = 0;   // own clock
+  std::string method;     // "trajectory_match", "teammate_match" (it identified me) or
+                          // "graph" (through teammate via_drone_id's own match)
+  int via_drone_id = -1;  // "graph": the teammate whose T_Gj_Gk was composed
   double mean_residual_m = 0.0;
   GlobalExtrinsic initial_T_Gi_Gj;
 };
 
 struct DroneOutput {
   lio::ScanOutput ego;
-  std::vector<TeammateEstimate> teammates;  // every teammate in the state
+  std::vector<TeammateEstimate> teammates;           // every teammate in the state
   std::vector<IdentificationEvent> identifications;  // in this scan
   std::vector<int> removed_teammates;                // left the state in this scan
-  int active_observations = 0;    // fused
-  int passive_observations = 0;   // fused
-  int gravity_alignments = 0;     // teammates' gravity fused
-  int rejected_observations = 0;  // gated out or unusable (no recent message)
-  bool extrinsics_frozen = false; // degeneracy policy applied
-  int num_detector_points = 0;    // full-resolution points given to the detector
+  int active_observations = 0;                       // fused
+  int passive_observations = 0;                      // fused
+  int gravity_alignments = 0;                        // teammates' gravity fused
+  int rejected_observations = 0;                     // gated out or unusable (no recent message)
+  bool extrinsics_frozen = false;                    // degeneracy policy applied
+  int num_detector_points = 0;                       // full-resolution points given to the detector
 };
 
 struct DroneEstimatorCounters {
@@ -102,8 +102,8 @@ struct DroneEstimatorCounters {
   int64_t teammates_removed = 0;
   int64_t active_fused = 0;
   int64_t passive_fused = 0;
-  int64_t passive_repeated = 0;     // of passive_fused: sent again after the first message (lost)
-  int64_t repeats_duplicate = 0;    // observations of this drone received twice: used once
+  int64_t passive_repeated = 0;   // of passive_fused: sent again after the first message (lost)
+  int64_t repeats_duplicate = 0;  // observations of this drone received twice: used once
   // Ignored: T_Gj_Gi from before this session, T_Gj_Gk from before k restarted.
   int64_t extrinsics_stale = 0;
   int64_t gravity_fused = 0;
@@ -128,7 +128,9 @@ std::string FormatBroadcastCounters(const DroneEstimatorCounters& c, const std::
 
 class DroneEstimator {
  public:
-  static Status Create(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar,
+  static Status Create(int self_id,
+                       const DroneEstimatorOptions& options,
+                       const LidarOptions& lidar,
                        std::unique_ptr<DroneEstimator>* estimator);
   ~DroneEstimator();
 
