@@ -91,6 +91,22 @@ class Checker {
       }
     }
   }
+  /// An airframe length in kAirframeLengthStepM codes: finite, and within
+  /// [0, 65.535] m (uint16) or, `may_be_negative`, +-32.767 m (int16).
+  void AirframeLength(const char* field, int index, double v, bool may_be_negative) {
+    const double steps = v / kAirframeLengthStepM;
+    const bool fits = may_be_negative ? std::abs(steps) < kAirframeCentreMaxCode + 0.5
+                                      : steps >= 0.0 && steps < kAirframeLengthMaxCode + 0.5;
+    if (!std::isfinite(v) || !fits) {
+      const double max_m = (may_be_negative ? kAirframeCentreMaxCode : kAirframeLengthMaxCode) *
+                           kAirframeLengthStepM;
+      Fail(field, index,
+           "= " + std::to_string(v) + " m is outside the wire range " +
+               (may_be_negative ? "+-" + std::to_string(max_m)
+                                : "[0, " + std::to_string(max_m) + "]") +
+               " m");
+    }
+  }
   void UnitQuaternion(const char* field, const Eigen::Quaterniond& q) {
     const Eigen::Vector4d c = q.coeffs();
     for (int i = 0; i < 4; ++i) {
@@ -230,16 +246,16 @@ Status Check(const EgoStateMessage& m) {
     const StateEcho& e = m.echoes[i];
     c.TeammateId("teammate_id", e.teammate_id, m.sender_id, &seen_echo);
     if (e.send_delay_ns < 0 || SyncDelayCode(e.send_delay_ns) > kSendDelayMaxCode) {
-      c.Fail("send_delay_ns", -1,
-             "= " + std::to_string(e.send_delay_ns) + " is outside " +
-                 delay_range(kSendDelayMaxCode));
+      c.Fail(
+          "send_delay_ns", -1,
+          "= " + std::to_string(e.send_delay_ns) + " is outside " + delay_range(kSendDelayMaxCode));
     }
     int64_t hold_ns = 0;
     if (!StateEchoHoldNs(m.stamp_ns, m.send_delay_ns, e.arrival_ns, &hold_ns) || hold_ns < 0 ||
         SyncDelayCode(hold_ns) > kHoldMaxCode) {
       c.Fail("arrival_ns", -1,
-             "= " + std::to_string(e.arrival_ns) +
-                 ": the hold (send time - arrival) is outside " + delay_range(kHoldMaxCode));
+             "= " + std::to_string(e.arrival_ns) + ": the hold (send time - arrival) is outside " +
+                 delay_range(kHoldMaxCode));
     }
   }
   return c.status();
@@ -282,6 +298,31 @@ Status Check(const TimeSyncMessage& m) {
   c.Stamp("t3_ns", m.t3_ns);
   if (!m.is_response && (m.t2_ns != 0 || m.t3_ns != 0)) {
     c.Fail("t2_ns", -1, "and t3_ns must be 0 in a request");
+  }
+  return c.status();
+}
+
+Status Check(const AirframeMessage& m) {
+  Checker c("Airframe");
+  c.Id("sender_id", m.sender_id);
+  c.Stamp("stamp_ns", m.stamp_ns);
+  if (m.reflector_shape < 0 || m.reflector_shape > kAirframeMaxShape) {
+    c.Fail("reflector_shape", -1,
+           "= " + std::to_string(m.reflector_shape) + " is not a shape (0 band, 1 box, 2 round)");
+  }
+  for (int i = 0; i < 3; ++i) {
+    c.AirframeLength("reflector_half_extents_m", i, m.reflector_half_extents_m[i], false);
+  }
+  for (int i = 0; i < 3; ++i) {
+    c.AirframeLength("reflector_centre_in_body_m", i, m.reflector_centre_in_body_m[i], true);
+  }
+  c.AirframeLength("depth_offset_m", -1, m.depth_offset_m, false);
+  c.AirframeLength("size_m", -1, m.size_m, false);
+  c.AirframeLength("centroid_sigma_m", -1, m.centroid_sigma_m, false);
+  if (!(m.min_intensity >= 0.0 && m.min_intensity <= kAirframeMaxIntensity)) {
+    c.Fail("min_intensity", -1,
+           "= " + std::to_string(m.min_intensity) + " is outside [0, " +
+               std::to_string(kAirframeMaxIntensity) + "]");
   }
   return c.status();
 }

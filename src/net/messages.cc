@@ -13,6 +13,8 @@ const char* MessageTypeName(MessageType type) {
       return "GlobalExtrinsic";
     case MessageType::kTimeSync:
       return "TimeSync";
+    case MessageType::kAirframe:
+      return "Airframe";
   }
   return "unknown";
 }
@@ -25,8 +27,11 @@ MessageType TypeOf(const SwarmMessage& message) {
           return MessageType::kEgoState;
         } else if constexpr (std::is_same_v<T, GlobalExtrinsicMessage>) {
           return MessageType::kGlobalExtrinsic;
-        } else {
+        } else if constexpr (std::is_same_v<T, TimeSyncMessage>) {
           return MessageType::kTimeSync;
+        } else {
+          static_assert(std::is_same_v<T, AirframeMessage>, "a message type without a MessageType");
+          return MessageType::kAirframe;
         }
       },
       message);
@@ -37,8 +42,11 @@ int SenderOf(const SwarmMessage& message) {
 }
 
 std::vector<GlobalExtrinsicMessage> SplitGlobalExtrinsics(
-    int sender_id, int64_t stamp_ns, const std::vector<GlobalExtrinsicEntry>& entries,
-    const Eigen::Vector3d& g_in_Gi, const Eigen::Matrix3d& cov_g_in_Gi) {
+    int sender_id,
+    int64_t stamp_ns,
+    const std::vector<GlobalExtrinsicEntry>& entries,
+    const Eigen::Vector3d& g_in_Gi,
+    const Eigen::Matrix3d& cov_g_in_Gi) {
   std::vector<GlobalExtrinsicMessage> messages;
   size_t begin = 0;
   do {

@@ -56,8 +56,11 @@ Status PacketCodec::Encode(const SwarmMessage& message,
           internal::EncodeEgoState(m, &w);
         } else if constexpr (std::is_same_v<T, GlobalExtrinsicMessage>) {
           internal::EncodeGlobalExtrinsic(m, &w);
-        } else {
+        } else if constexpr (std::is_same_v<T, TimeSyncMessage>) {
           internal::EncodeTimeSync(m, &w);
+        } else {
+          static_assert(std::is_same_v<T, AirframeMessage>, "a message type without an encoder");
+          internal::EncodeAirframe(m, &w);
         }
       },
       message);
@@ -97,7 +100,7 @@ Status PacketCodec::Decode(const uint8_t* data, size_t size, DecodedPacket* pack
                                    " (this build speaks " + std::to_string(kProtocolVersion) + ")");
   }
   if (type < static_cast<uint8_t>(MessageType::kEgoState) ||
-      type > static_cast<uint8_t>(MessageType::kTimeSync)) {
+      type > static_cast<uint8_t>(MessageType::kAirframe)) {
     return Status::InvalidArgument("unknown message type " + std::to_string(type));
   }
   if (!IsValidDroneId(sender)) {
@@ -135,6 +138,12 @@ Status PacketCodec::Decode(const uint8_t* data, size_t size, DecodedPacket* pack
     case MessageType::kTimeSync: {
       TimeSyncMessage m;
       SWARMLIO_RETURN_IF_ERROR(internal::DecodeTimeSync(sender, &r, &m).WithContext("TimeSync"));
+      decoded.message = m;
+      break;
+    }
+    case MessageType::kAirframe: {
+      AirframeMessage m;
+      SWARMLIO_RETURN_IF_ERROR(internal::DecodeAirframe(sender, &r, &m).WithContext("Airframe"));
       decoded.message = m;
       break;
     }

@@ -44,6 +44,7 @@ class PacketReader {
     return Status::Ok();
   }
   Status U16(const char* field, uint16_t* value) { return Get(field, -1, 2, value); }
+  Status U16(const char* field, int index, uint16_t* value) { return Get(field, index, 2, value); }
   Status U32(const char* field, uint32_t* value) { return Get(field, -1, 4, value); }
   Status I16(const char* field, int index, int16_t* value) {
     uint16_t bits = 0;

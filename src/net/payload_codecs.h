@@ -25,4 +25,7 @@ Status DecodeGlobalExtrinsic(int sender_id, PacketReader* r, GlobalExtrinsicMess
 void EncodeTimeSync(const TimeSyncMessage& message, PacketWriter* w);
 Status DecodeTimeSync(int sender_id, PacketReader* r, TimeSyncMessage* message);
 
+void EncodeAirframe(const AirframeMessage& message, PacketWriter* w);
+Status DecodeAirframe(int sender_id, PacketReader* r, AirframeMessage* message);
+
 }  // namespace swarmlio::net::internal

@@ -1,11 +1,15 @@
-// Broadcaster: what leaves after each scan: the own state, and
-// within the byte budget (broadcast_budget.h) the echoes for the teammates'
-// clock sync, the observations of teammates, the repeats of the previous
-// scan's observations, and the own T_Gi_Gj estimates with gravity.
+// Broadcaster: what leaves after each scan: the own state, the own airframe
+// when due, and within the byte budget (broadcast_budget.h) the echoes for
+// the teammates' clock sync, the observations of teammates, the repeats of
+// the previous scan's observations, and the own T_Gi_Gj estimates with
+// gravity.
 // docs/swarm.md "Broadcast budget", docs/network.md section 2.2.
 //
 // Priorities, highest first (what a crowded drone keeps):
-//   1. the state (always);
+//   1. the state (always), and the own airframe with the first scan's
+//      messages and then every airframe_period_s (always when due: 78 B
+//      every 2 s by default, and without it teammates whose gates are
+//      stricter than this body may not detect it);
 //   2. echoes for teammates whose clock offset is not converged yet (without
 //      them no teammate can use this drone's states; 7 B each), at most
 //      urgent_echoes_per_state;
@@ -28,6 +32,8 @@
 // not fit is skipped and the smaller items after it take what is left. An
 // item that does not fit waits: a later scan, with more credit or fewer
 // teammates in view, sends it.
+#include "broadcaster.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <limits>
@@ -36,7 +42,7 @@
 #include <variant>
 #include <vector>
 
-#include "broadcaster.h"
+#include "airframe_message.h"
 #include "swarmlio/common/time.h"
 #include "swarmlio/math/so3.h"
 #include "swarmlio/net/wire_format.h"
@@ -59,12 +65,14 @@ size_t ExtrinsicWireBytes(const BroadcastBudget& budget, size_t n) {
 // Overdue T_Gi_Gj entries may take at most this share of the byte budget.
 constexpr double kOverdueBudgetShare = 0.1;
 
-bool ChooseExtrinsicEntries(const std::vector<int>& candidates, int max_entries,
-                            BroadcastBudget* budget, std::vector<int>* chosen) {
+bool ChooseExtrinsicEntries(const std::vector<int>& candidates,
+                            int max_entries,
+                            BroadcastBudget* budget,
+                            std::vector<int>* chosen) {
   for (int id : candidates) {
     if (max_entries > 0 && static_cast<int>(chosen->size()) >= max_entries) return true;
-    const size_t extra =
-        ExtrinsicWireBytes(*budget, chosen->size() + 1) - ExtrinsicWireBytes(*budget, chosen->size());
+    const size_t extra = ExtrinsicWireBytes(*budget, chosen->size() + 1) -
+                         ExtrinsicWireBytes(*budget, chosen->size());
     if (!budget->TrySpend(extra)) return false;
     chosen->push_back(id);
   }
@@ -75,14 +83,15 @@ bool ChooseExtrinsicEntries(const std::vector<int>& candidates, int max_entries,
 
 std::string FormatBroadcastCounters(const DroneEstimatorCounters& c, const std::string& indent) {
   char line[256];
-  std::snprintf(line, sizeof(line),
-                "broadcast: %lld B states, %lld B echoes, %lld B observations (%lld left out by "
-                "the byte budget), %lld B repeats, %lld B extrinsics\n",
-                static_cast<long long>(c.sent_state_bytes), static_cast<long long>(c.sent_echo_bytes),
-                static_cast<long long>(c.sent_observation_bytes),
-                static_cast<long long>(c.observations_unsent),
-                static_cast<long long>(c.sent_repeat_bytes),
-                static_cast<long long>(c.sent_extrinsic_bytes));
+  std::snprintf(
+      line, sizeof(line),
+      "broadcast: %lld B states, %lld B echoes, %lld B observations (%lld left out by "
+      "the byte budget), %lld B repeats, %lld B extrinsics, %lld B airframe\n",
+      static_cast<long long>(c.sent_state_bytes), static_cast<long long>(c.sent_echo_bytes),
+      static_cast<long long>(c.sent_observation_bytes),
+      static_cast<long long>(c.observations_unsent), static_cast<long long>(c.sent_repeat_bytes),
+      static_cast<long long>(c.sent_extrinsic_bytes),
+      static_cast<long long>(c.sent_airframe_bytes));
   return indent + line;
 }
 
@@ -109,8 +118,9 @@ struct Broadcaster::Pass {
 void Broadcaster::Broadcast(const BroadcastScan& scan) {
   budget_.Refill(scan.t_k);
   Pass pass(scan);
-  // 1. The state.
+  // 1. The state, and the own airframe when due.
   MakeState(&pass);
+  AnnounceAirframe(scan.t_k);
   // 2. Echoes for teammates whose clock offset is not converged: teammates'
   // states back to them (the send delay is set when the packet leaves,
   // MessageChannel::Send).
@@ -161,6 +171,21 @@ void Broadcaster::MakeState(Pass* pass) {
   pass->send_state = m.q_Gj_bj.coeffs().allFinite() && m.p_bj_in_Gj.allFinite();
   pass->state_bytes = budget_.WireBytes(net::EgoStatePacketBytes(0));
   if (pass->send_state) budget_.Spend(pass->state_bytes);
+}
+
+void Broadcaster::AnnounceAirframe(int64_t t_k) {
+  // With the first scan's messages, then every airframe_period_s of the own
+  // clock; paid whatever the credit, like the state.
+  const double period = options_.airframe_period_s;
+  const bool due =
+      period > 0.0 && (!airframe_announced_ || ToSeconds(t_k - last_airframe_ns_) >= period);
+  if (!due) return;
+  const size_t bytes = budget_.WireBytes(net::AirframePacketBytes());
+  budget_.Spend(bytes);
+  counters_->sent_airframe_bytes += static_cast<int64_t>(bytes);
+  messages_.push_back(ToAirframeMessage(self_id_, t_k, airframe_));
+  last_airframe_ns_ = t_k;
+  airframe_announced_ = true;
 }
 
 void Broadcaster::AddEchoes(net::ClockSync::EchoSelection selection, int most, Pass* pass) {
@@ -242,10 +267,12 @@ void Broadcaster::AddRepeats(Pass* pass) {
     if (!pass->send_state || pass->blocked) break;
     o.age_ns = pass->scan.t_k - repeat_stamp_ns_;
     if (o.age_ns <= 0 || net::PastObservationAgeCode(o.age_ns) > net::kPastObservationAgeMaxCode ||
-        !((o.p_bk_in_Gj - m.p_bj_in_Gj).array().abs() < 0.9 * net::kObservationPositionMaxM).all()) {
+        !((o.p_bk_in_Gj - m.p_bj_in_Gj).array().abs() < 0.9 * net::kObservationPositionMaxM)
+             .all()) {
       continue;
     }
-    if (static_cast<int>(m.past_observations.size()) >= net::EgoStateMessage::kMaxPastObservations) {
+    if (static_cast<int>(m.past_observations.size()) >=
+        net::EgoStateMessage::kMaxPastObservations) {
       break;
     }
     const size_t bytes = net::kPastObservationBytes + (m.past_observations.empty() ? 1 : 0);
@@ -338,7 +365,8 @@ void Broadcaster::SendExtrinsics(Pass* pass) {
   }
 }
 
-void Broadcaster::RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,
+void Broadcaster::RememberForRepeat(const net::EgoStateMessage& m,
+                                    const SwarmState& x,
                                     const Eigen::MatrixXd& P) {
   const RepeatObservations policy = options_.repeat_observations;
   if (policy == RepeatObservations::kNone) return;
@@ -354,7 +382,8 @@ void Broadcaster::RememberForRepeat(const net::EgoStateMessage& m, const SwarmSt
   for (const net::CurrentObservation& o : m.observations) {
     if (policy == RepeatObservations::kDegenerateTeammates) {
       const auto it = registry_->teammates().find(o.observed_id);
-      if (it == registry_->teammates().end() || !it->second.have_message || !it->second.last.degenerated) {
+      if (it == registry_->teammates().end() || !it->second.have_message ||
+          !it->second.last.degenerated) {
         continue;
       }
     }

@@ -1,7 +1,8 @@
 // The per-drone component's broadcaster (docs/swarm.md "Broadcast budget",
 // docs/network.md section 2.2): after each scan, the own state with what
 // fits the byte budget of clock-sync echoes, observations of teammates and
-// repeats, and the own T_Gi_Gj estimates with gravity when new or due; the
+// repeats, the own airframe when due, and the own T_Gi_Gj estimates with
+// gravity when new or due; the
 // answers to the teammates' clock-sync requests and the own requests when
 // the driver takes the messages. Internal to src/swarm.
 #pragma once
@@ -19,6 +20,7 @@
 #include "swarmlio/swarm/broadcast_budget.h"
 #include "swarmlio/swarm/drone_estimator.h"
 #include "swarmlio/swarm/swarm_options.h"
+#include "swarmlio/teammate/airframe.h"
 #include "swarmlio/teammate/observation.h"
 #include "teammate_registry.h"
 
@@ -26,22 +28,28 @@ namespace swarmlio::swarm::internal {
 
 /// What the broadcast of one scan is made of.
 struct BroadcastScan {
-  int64_t t_k = 0;                   // the scan end (own clock)
-  const SwarmState* x = nullptr;     // the posterior
+  int64_t t_k = 0;                // the scan end (own clock)
+  const SwarmState* x = nullptr;  // the posterior
   const Eigen::MatrixXd* P = nullptr;
-  bool degenerate = false;           // the scan's degeneracy flag
-  int64_t session_start_ns = 0;      // the odometry's initialization stamp
+  bool degenerate = false;                              // the scan's degeneracy flag
+  int64_t session_start_ns = 0;                         // the odometry's initialization stamp
   Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();  // the newest gyro sample [rad/s]
   const std::vector<teammate::TeammateObservation>* observations = nullptr;  // this scan's
 };
 
 class Broadcaster {
  public:
+  /// `airframe`: this drone's own, announced every options.airframe_period_s.
   /// `clock_sync` may be null (no clock synchronisation); the pointers outlive the broadcaster.
-  Broadcaster(int self_id, const SwarmOptions& options, net::ClockSync* clock_sync,
-              TeammateRegistry* registry, DroneEstimatorCounters* counters)
+  Broadcaster(int self_id,
+              const SwarmOptions& options,
+              const teammate::AirframeDescription& airframe,
+              net::ClockSync* clock_sync,
+              TeammateRegistry* registry,
+              DroneEstimatorCounters* counters)
       : self_id_(self_id),
         options_(options),
+        airframe_(airframe),
         clock_sync_(clock_sync),
         registry_(registry),
         counters_(counters),
@@ -62,6 +70,7 @@ class Broadcaster {
   struct Pass;
   // The steps of Broadcast, in priority order (broadcaster.cc's header).
   void MakeState(Pass* pass);
+  void AnnounceAirframe(int64_t t_k);
   void AddEchoes(net::ClockSync::EchoSelection selection, int most, Pass* pass);
   void ChooseNewExtrinsics(Pass* pass);
   void SortObservations(Pass* pass);
@@ -72,11 +81,13 @@ class Broadcaster {
   void SendExtrinsics(Pass* pass);
   // Keeps the observations of the state message `m` that the next message
   // repeats (SwarmOptions::repeat_observations), moved into G_i.
-  void RememberForRepeat(const net::EgoStateMessage& m, const SwarmState& x,
+  void RememberForRepeat(const net::EgoStateMessage& m,
+                         const SwarmState& x,
                          const Eigen::MatrixXd& P);
 
   int self_id_;
   SwarmOptions options_;
+  teammate::AirframeDescription airframe_;
   net::ClockSync* clock_sync_;
   TeammateRegistry* registry_;
   DroneEstimatorCounters* counters_;
@@ -87,6 +98,8 @@ class Broadcaster {
   SendRotation extrinsic_rotation_;
   int64_t last_extrinsic_broadcast_ns_ = 0;
   bool broadcast_extrinsics_once_ = false;
+  int64_t last_airframe_ns_ = 0;
+  bool airframe_announced_ = false;
   // This scan's observations to send again with the next state message
   // (SwarmOptions::repeat_observations), in G_i; age_ns unset.
   std::vector<net::PastObservation> repeat_;

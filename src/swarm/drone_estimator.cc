@@ -18,22 +18,24 @@
 #include "teammate_registry.h"
 
 namespace swarmlio::swarm {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 // The collaborators, in construction order (each refers to those above it).
 struct DroneEstimator::Parts {
-  Parts(int self_id, const DroneEstimatorOptions& o, const LidarOptions& lidar,
-        teammate::TeammateDetector* detector, std::unique_ptr<net::ClockSync> sync,
+  Parts(int self_id,
+        const DroneEstimatorOptions& o,
+        const LidarOptions& lidar,
+        teammate::TeammateDetector* detector,
+        std::unique_ptr<net::ClockSync> sync,
         DroneEstimatorCounters* counters)
       : clock_sync(std::move(sync)),
         registry(self_id, o.swarm, detector),
         active(o.swarm, &registry, &detection.observations, counters),
         passive(o.swarm, &registry, counters),
         gravity(o.swarm, counters),
-        broadcaster(self_id, o.swarm, clock_sync.get(), &registry, counters),
-        inbox(self_id, o.swarm,
+        broadcaster(self_id, o.swarm, o.airframe, clock_sync.get(), &registry, counters),
+        inbox(self_id,
+              o.swarm,
               {&registry, &passive, &gravity, &broadcaster, detector, clock_sync.get(), counters}),
         detector_input(o.teammate, o.swarm, lidar) {}
 
@@ -63,16 +65,19 @@ std::string DroneEstimatorOptions::Validate() const {
   if (std::string e = odometry.Validate(); !e.empty()) return "odometry." + e;
   if (std::string e = teammate.Validate(); !e.empty()) return "teammate." + e;
   if (std::string e = swarm.Validate(); !e.empty()) return "swarm." + e;
+  if (std::string e = airframe.Validate(); !e.empty()) return "airframe." + e;
   return "";
 }
 
-DroneEstimator::DroneEstimator(int self_id, const DroneEstimatorOptions& options,
+DroneEstimator::DroneEstimator(int self_id,
+                               const DroneEstimatorOptions& options,
                                const LidarOptions& lidar)
     : self_id_(self_id), options_(options), lidar_(lidar) {}
 
 DroneEstimator::~DroneEstimator() = default;
 
-Status DroneEstimator::Create(int self_id, const DroneEstimatorOptions& options,
+Status DroneEstimator::Create(int self_id,
+                              const DroneEstimatorOptions& options,
                               const LidarOptions& lidar,
                               std::unique_ptr<DroneEstimator>* estimator) {
   if (self_id < 0) return Status::InvalidArgument("drone id must be >= 0");
@@ -84,7 +89,8 @@ Status DroneEstimator::Create(int self_id, const DroneEstimatorOptions& options,
   out->detector_ = std::make_unique<teammate::TeammateDetector>(self_id, options.teammate);
   std::unique_ptr<net::ClockSync> clock_sync;
   if (options.swarm.synchronize_clocks) {
-    SWARMLIO_RETURN_IF_ERROR(net::ClockSync::Create(self_id, options.swarm.clock_sync, &clock_sync));
+    SWARMLIO_RETURN_IF_ERROR(
+        net::ClockSync::Create(self_id, options.swarm.clock_sync, &clock_sync));
   }
   out->parts_ = std::make_unique<Parts>(self_id, options, lidar, out->detector_.get(),
                                         std::move(clock_sync), &out->counters_);
@@ -176,8 +182,8 @@ Status DroneEstimator::FrontEnd(lio::ScanContext* scan, lio::UpdateRequest* requ
   // scan's reflective points at full resolution. The trackers read T_Gi_Gj
   // from the state (its one owner).
   SWARMLIO_RETURN_IF_ERROR(p.detector_input.Make(scan->raw, t_k, *scan->poses, x, p.detection,
-                                                 p.last_detection_ns,
-                                                 detector_->min_reflectivity(), &p.points));
+                                                 p.last_detection_ns, detector_->min_reflectivity(),
+                                                 &p.points));
   p.report.detector_points = static_cast<int>(p.points.size());
   for (int id : x.layout().teammate_ids()) {
     detector_->SetGlobalExtrinsic(id, x.teammate(id).T_Ga_Gb());

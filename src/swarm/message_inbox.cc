@@ -4,6 +4,7 @@
 #include <cmath>
 #include <variant>
 
+#include "airframe_message.h"
 #include "swarmlio/common/time.h"
 #include "swarmlio/net/wire_format.h"
 
@@ -37,7 +38,8 @@ bool MessageInbox::MadeInSessionOf(int teammate_id, int sender_id, int64_t sende
   return local_ns >= it->second.session_heard_ns + margin_ns;
 }
 
-bool MessageInbox::MadeInThisSession(int sender_id, int64_t sender_stamp_ns,
+bool MessageInbox::MadeInThisSession(int sender_id,
+                                     int64_t sender_stamp_ns,
                                      const OwnSession& own) const {
   if (!own.started) return false;
   int64_t local_ns = 0;
@@ -56,6 +58,8 @@ void MessageInbox::Route(const net::ReceivedMessage& received, const OwnSession&
     OnExtrinsics(*g, own);
   } else if (const auto* s = std::get_if<net::EgoStateMessage>(&received.message)) {
     OnState(*s, received.arrival_ns);
+  } else if (const auto* a = std::get_if<net::AirframeMessage>(&received.message)) {
+    OnAirframe(*a);
   } else {
     ++to_.counters->messages_ignored;
   }
@@ -138,7 +142,8 @@ void MessageInbox::OnState(const net::EgoStateMessage& received, int64_t arrival
     }
   }
   TeammateInfo& info = to_.registry->teammates()[m.sender_id];
-  if (info.have_message && m.session_start_ns != info.session_start_ns) OnRestart(m.sender_id, arrival_ns);
+  if (info.have_message && m.session_start_ns != info.session_start_ns)
+    OnRestart(m.sender_id, arrival_ns);
   if (info.have_message && m.stamp_ns <= info.last.stamp_ns) {
     ++to_.counters->messages_ignored;  // older than what we have (reordered)
   } else {
@@ -157,6 +162,16 @@ void MessageInbox::OnState(const net::EgoStateMessage& received, int64_t arrival
   odometry.degenerate = m.degenerated;
   to_.detector->AddTeammateOdometry(odometry);
   QueueObservations(received, m);
+}
+
+void MessageInbox::OnAirframe(const net::AirframeMessage& a) {
+  // The body does not change with a session or a clock: every valid
+  // announcement is taken as it arrives (the same one again changes nothing).
+  teammate::AirframeDescription airframe;
+  if (a.sender_id == self_id_ || a.sender_id < 0 || !FromAirframeMessage(a, &airframe) ||
+      !to_.detector->SetTeammateAirframe(a.sender_id, airframe)) {
+    ++to_.counters->messages_ignored;
+  }
 }
 
 void MessageInbox::OnRestart(int j, int64_t arrival_ns) {

@@ -5,9 +5,9 @@
 // (its matches) to the teammate registry, its gravity to the gravity
 // updater; a state to the registry (the newest state, sessions and
 // restarts), the detector (the broadcast trajectory) and, for each
-// observation of this drone it carries, the passive updater. Bad or own
-// messages are counted and ignored. An extrinsic entry's frames (the wire's
-// neutral T_Ga_Gb, a = sender) are named here, once: T_Gj_Gi or T_Gj_Gk.
+// observation of this drone it carries, the passive updater; a teammate's
+// airframe to the detector. Bad or own messages are counted and ignored. An extrinsic entry's
+// frames (the wire's neutral T_Ga_Gb, a = sender) are named here, once: T_Gj_Gi or T_Gj_Gk.
 // Internal to src/swarm.
 #pragma once
 
@@ -54,6 +54,7 @@ class MessageInbox {
   void OnTimeSync(const net::TimeSyncMessage& t, int64_t arrival_ns);
   void OnExtrinsics(const net::GlobalExtrinsicMessage& g, const OwnSession& own);
   void OnState(const net::EgoStateMessage& received, int64_t arrival_ns);
+  void OnAirframe(const net::AirframeMessage& a);
   // j rebooted (its session changed): what this drone had of it goes.
   void OnRestart(int j, int64_t arrival_ns);
   // j's observations of this drone in message `m` (stamps in the own clock)

@@ -15,6 +15,7 @@ namespace swarmlio::net {
 namespace {
 
 using net_test::AllExampleMessages;
+using net_test::MakeAirframe;
 using net_test::MakeCodec;
 using net_test::MakeEgoState;
 using net_test::MakeGlobalExtrinsic;
@@ -338,7 +339,7 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
     ExpectRejected(p, "session_start_ns' is negative");
   }
   const size_t first = kEgoFirstEcho;  // the first observation (no echoes)
-  {  // observed id out of range
+  {                                    // observed id out of range
     std::vector<uint8_t> p = ego;
     p[first] = 200;
     Resign(&p);
@@ -400,6 +401,59 @@ TEST(PacketCodecRobustness, AuthenticatedButMalformedPayloadsAreRejected) {
     p.insert(p.end() - kTagBytes, 1, 0);
     Resign(&p);
     ExpectRejected(p, "trailing bytes");
+  }
+}
+
+/// Payload offsets of the Airframe fields (wire_format.h).
+constexpr size_t kAirframeShape = kHeaderBytes + 8;
+constexpr size_t kAirframeCentre = kHeaderBytes + 16;
+
+TEST(PacketCodecRobustness, MalformedAirframesAreRejected) {
+  const std::vector<uint8_t> airframe = Encode(MakeAirframe(4, 302));
+  {  // sanity: Resign alone keeps the packet valid, and the shape is where we think
+    std::vector<uint8_t> p = airframe;
+    Resign(&p);
+    ASSERT_TRUE(Decode(p).ok());
+    EXPECT_EQ(p[kAirframeShape], 2);  // seed 302: round
+  }
+  for (uint8_t shape : {3, 255}) {  // unknown shapes
+    std::vector<uint8_t> p = airframe;
+    p[kAirframeShape] = shape;
+    Resign(&p);
+    ExpectRejected(
+        p, "Airframe: field 'reflector_shape' has the unknown value " + std::to_string(shape));
+  }
+  {  // a centre code of -32768 (the range is +-32767 mm)
+    std::vector<uint8_t> p = airframe;
+    PutU16(&p, kAirframeCentre + 2, 0x8000);
+    Resign(&p);
+    ExpectRejected(p, "field 'reflector_centre_in_body_m[1]' has the out-of-range code -32768");
+  }
+  {  // a negative stamp
+    std::vector<uint8_t> p = airframe;
+    for (int i = 0; i < 8; ++i) p[kHeaderBytes + i] = 0xFF;
+    Resign(&p);
+    ExpectRejected(p, "Airframe: field 'stamp_ns' is negative");
+  }
+  {  // one byte short, one byte too many
+    std::vector<uint8_t> p = airframe;
+    p.erase(p.end() - kTagBytes - 1);
+    Resign(&p);
+    ExpectRejected(p, "truncated reading field 'centroid_sigma_m'");
+    p = airframe;
+    p.insert(p.end() - kTagBytes, 1, 0);
+    Resign(&p);
+    ExpectRejected(p, "trailing bytes");
+  }
+  {  // another type's payload under the Airframe type, and the reverse
+    std::vector<uint8_t> p = Encode(MakeTimeSync(1, 2, false));
+    p[2] = static_cast<uint8_t>(MessageType::kAirframe);
+    Resign(&p);
+    ExpectRejected(p, "Airframe");
+    p = airframe;
+    p[2] = static_cast<uint8_t>(MessageType::kTimeSync);
+    Resign(&p);
+    EXPECT_FALSE(Decode(p).ok());
   }
 }
 

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <sodium.h>
 
+#include <cmath>
 #include <limits>
 
 #include "swarmlio/net/packet_codec.h"
@@ -13,9 +14,11 @@ namespace {
 
 using net_test::AllExampleMessages;
 using net_test::ExpectSameMessage;
+using net_test::MakeAirframe;
 using net_test::MakeCodec;
 using net_test::MakeEgoState;
 using net_test::MakeGlobalExtrinsic;
+using net_test::MakeRawAirframe;
 using net_test::MakeTimeSync;
 
 size_t ExpectedPacketBytes(const SwarmMessage& m) {
@@ -26,6 +29,7 @@ size_t ExpectedPacketBytes(const SwarmMessage& m) {
   if (const auto* g = std::get_if<GlobalExtrinsicMessage>(&m)) {
     return GlobalExtrinsicPacketBytes(g->entries.size());
   }
+  if (std::holds_alternative<AirframeMessage>(m)) return AirframePacketBytes();
   return TimeSyncPacketBytes();
 }
 
@@ -64,16 +68,59 @@ TEST(PacketCodec, DocumentedSizes) {
   EXPECT_EQ(EgoStatePacketBytes(2), 114u);
   EXPECT_EQ(EgoStatePacketBytes(4), 140u);
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations), 400u);
-  EXPECT_EQ(EgoStatePacketBytes(1, 1), 117u);  // one observation, repeated in the next
-  EXPECT_EQ(EgoStatePacketBytes(1, 0, 1), 108u);  // one observation, one clock echo
+  EXPECT_EQ(EgoStatePacketBytes(1, 1), 117u);          // one observation, repeated in the next
+  EXPECT_EQ(EgoStatePacketBytes(1, 0, 1), 108u);       // one observation, one clock echo
   EXPECT_EQ(EgoStatePacketBytes(0, 0, 0, true), 92u);  // an offset report
   EXPECT_EQ(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
-                                EgoStateMessage::kMaxPastObservations,
-                                EgoStateMessage::kMaxEchoes), 817u);
+                                EgoStateMessage::kMaxPastObservations, EgoStateMessage::kMaxEchoes),
+            817u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(0), 49u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(1), 90u);
   EXPECT_EQ(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries), 377u);
   EXPECT_EQ(TimeSyncPacketBytes(), 48u);
+  EXPECT_EQ(AirframePacketBytes(), 50u);
+}
+
+// Lengths travel in millimetre steps, the intensity in whole units: decoded
+// within half a step of what was sent, for every shape.
+TEST(PacketCodec, AirframeRoundTripsWithinTheQuantization) {
+  const PacketCodec codec = MakeCodec();
+  for (uint64_t seed = 0; seed < 300; ++seed) {
+    const AirframeMessage m = MakeRawAirframe(static_cast<int>(seed % 64), seed);
+    std::vector<uint8_t> packet;
+    ASSERT_TRUE(codec.Encode(m, 0, &packet).ok());
+    ASSERT_EQ(packet.size(), AirframePacketBytes());
+    DecodedPacket decoded;
+    const Status s = codec.Decode(packet.data(), packet.size(), &decoded);
+    ASSERT_TRUE(s.ok()) << s.message();
+    const auto& d = std::get<AirframeMessage>(decoded.message);
+    constexpr double kHalfStepM = 0.5 * kAirframeLengthStepM + 1e-12;
+    EXPECT_EQ(d.sender_id, m.sender_id);
+    EXPECT_EQ(d.stamp_ns, m.stamp_ns);
+    EXPECT_EQ(d.reflector_shape, m.reflector_shape);
+    EXPECT_LE((d.reflector_half_extents_m - m.reflector_half_extents_m).cwiseAbs().maxCoeff(),
+              kHalfStepM);
+    EXPECT_LE((d.reflector_centre_in_body_m - m.reflector_centre_in_body_m).cwiseAbs().maxCoeff(),
+              kHalfStepM);
+    EXPECT_LE(std::abs(d.depth_offset_m - m.depth_offset_m), kHalfStepM);
+    EXPECT_LE(std::abs(d.size_m - m.size_m), kHalfStepM);
+    EXPECT_LE(std::abs(d.centroid_sigma_m - m.centroid_sigma_m), kHalfStepM);
+    EXPECT_LE(std::abs(d.min_intensity - m.min_intensity), 0.5);
+    EXPECT_EQ(d.min_intensity, std::round(d.min_intensity));
+  }
+  // The ends of the wire ranges.
+  AirframeMessage m = MakeRawAirframe(1, 7);
+  m.reflector_half_extents_m = {0.0, 65.535, 0.0};
+  m.reflector_centre_in_body_m = {-32.767, 32.767, 0.0};
+  m.min_intensity = 255.0;
+  std::vector<uint8_t> packet;
+  ASSERT_TRUE(codec.Encode(m, 0, &packet).ok());
+  DecodedPacket decoded;
+  ASSERT_TRUE(codec.Decode(packet.data(), packet.size(), &decoded).ok());
+  const auto& d = std::get<AirframeMessage>(decoded.message);
+  EXPECT_NEAR(d.reflector_half_extents_m.y(), 65.535, 1e-9);
+  EXPECT_NEAR(d.reflector_centre_in_body_m.x(), -32.767, 1e-9);
+  EXPECT_EQ(d.min_intensity, 255.0);
 }
 
 TEST(PacketCodec, HeaderIsLittleEndianAndPacked) {
@@ -171,6 +218,28 @@ TEST(PacketCodec, EncodeRejectsInvalidMessages) {
   t = MakeTimeSync(1, 2, false);
   t.t2_ns = 5;
   expect_rejected(t, "t2_ns");
+
+  AirframeMessage a = MakeAirframe(4, 1);
+  a.reflector_shape = 3;
+  expect_rejected(a, "reflector_shape");
+  a = MakeAirframe(4, 1);
+  a.reflector_half_extents_m.z() = -0.001;
+  expect_rejected(a, "reflector_half_extents_m[2]' = -0.001000 m is outside the wire range");
+  a = MakeAirframe(4, 1);
+  a.reflector_centre_in_body_m.y() = 40.0;  // beyond +-32.767 m
+  expect_rejected(a, "reflector_centre_in_body_m[1]");
+  a = MakeAirframe(4, 1);
+  a.size_m = std::numeric_limits<double>::quiet_NaN();
+  expect_rejected(a, "size_m");
+  a = MakeAirframe(4, 1);
+  a.depth_offset_m = 65.536;  // beyond the uint16 code
+  expect_rejected(a, "depth_offset_m");
+  a = MakeAirframe(4, 1);
+  a.min_intensity = 256.0;
+  expect_rejected(a, "min_intensity");
+  a = MakeAirframe(4, 1);
+  a.stamp_ns = -1;
+  expect_rejected(a, "stamp_ns");
 }
 
 TEST(PacketCodec, UncreatedCodecFails) {

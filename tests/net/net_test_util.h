@@ -65,8 +65,11 @@ class ValueSource {
   std::mt19937_64 engine_;
 };
 
-inline EgoStateMessage MakeRawEgoState(int sender, int num_observations, uint64_t seed,
-                                       int num_past_observations = 0, int num_echoes = 0) {
+inline EgoStateMessage MakeRawEgoState(int sender,
+                                       int num_observations,
+                                       uint64_t seed,
+                                       int num_past_observations = 0,
+                                       int num_echoes = 0) {
   ValueSource v(seed);
   EgoStateMessage m;
   m.sender_id = sender;
@@ -134,6 +137,22 @@ inline GlobalExtrinsicMessage MakeRawGlobalExtrinsic(int sender, int num_entries
   return m;
 }
 
+/// An airframe with random lengths (not on the millimetre grid).
+inline AirframeMessage MakeRawAirframe(int sender, uint64_t seed) {
+  ValueSource v(seed);
+  AirframeMessage m;
+  m.sender_id = sender;
+  m.stamp_ns = 43'000'000'000 + static_cast<int64_t>(seed);
+  m.reflector_shape = static_cast<int>(seed % 3);
+  m.reflector_half_extents_m = {v.Uniform(0.0, 2.0), v.Uniform(0.0, 2.0), v.Uniform(0.0, 2.0)};
+  m.reflector_centre_in_body_m = v.Vector64(2.0);
+  m.depth_offset_m = v.Uniform(0.0, 1.0);
+  m.size_m = v.Uniform(0.05, 5.0);
+  m.min_intensity = v.Uniform(0.0, 255.0);
+  m.centroid_sigma_m = v.Uniform(0.0, 1.0);
+  return m;
+}
+
 inline PacketCodec MakeCodec(uint64_t key_seed = 7) {
   PacketCodec codec;
   const Status s = PacketCodec::Create(SwarmKey::ForSimulation(key_seed), &codec);
@@ -158,14 +177,21 @@ Message OnTheWire(const Message& message) {
   return std::get<Message>(decoded.message);
 }
 
-inline EgoStateMessage MakeEgoState(int sender, int num_observations, uint64_t seed,
-                                    int num_past_observations = 0, int num_echoes = 0) {
+inline EgoStateMessage MakeEgoState(int sender,
+                                    int num_observations,
+                                    uint64_t seed,
+                                    int num_past_observations = 0,
+                                    int num_echoes = 0) {
   return OnTheWire(
       MakeRawEgoState(sender, num_observations, seed, num_past_observations, num_echoes));
 }
 
 inline GlobalExtrinsicMessage MakeGlobalExtrinsic(int sender, int num_entries, uint64_t seed) {
   return OnTheWire(MakeRawGlobalExtrinsic(sender, num_entries, seed));
+}
+
+inline AirframeMessage MakeAirframe(int sender, uint64_t seed) {
+  return OnTheWire(MakeRawAirframe(sender, seed));
 }
 
 inline TimeSyncMessage MakeTimeSync(int sender, int target, bool response) {
@@ -236,6 +262,17 @@ inline void ExpectSameMessage(const SwarmMessage& expected, const SwarmMessage& 
       EXPECT_EQ(g->entries[i].p_Gb_in_Ga, a.entries[i].p_Gb_in_Ga);
       EXPECT_EQ(g->entries[i].covariance, a.entries[i].covariance);
     }
+  } else if (const auto* f = std::get_if<AirframeMessage>(&expected)) {
+    const auto& a = std::get<AirframeMessage>(actual);
+    EXPECT_EQ(f->sender_id, a.sender_id);
+    EXPECT_EQ(f->stamp_ns, a.stamp_ns);
+    EXPECT_EQ(f->reflector_shape, a.reflector_shape);
+    EXPECT_EQ(f->reflector_half_extents_m, a.reflector_half_extents_m);
+    EXPECT_EQ(f->reflector_centre_in_body_m, a.reflector_centre_in_body_m);
+    EXPECT_EQ(f->depth_offset_m, a.depth_offset_m);
+    EXPECT_EQ(f->size_m, a.size_m);
+    EXPECT_EQ(f->min_intensity, a.min_intensity);
+    EXPECT_EQ(f->centroid_sigma_m, a.centroid_sigma_m);
   } else {
     const auto& e2 = std::get<TimeSyncMessage>(expected);
     const auto& a = std::get<TimeSyncMessage>(actual);
@@ -261,7 +298,8 @@ inline std::vector<SwarmMessage> AllExampleMessages() {
   messages.push_back(MakeEgoState(3, EgoStateMessage::kMaxObservations, 153,
                                   EgoStateMessage::kMaxPastObservations,
                                   EgoStateMessage::kMaxEchoes));
-  for (const auto& [echoes, std_code] : {std::pair{0, 1}, std::pair{2, ClockOffsetReport::kMaxStdCode}}) {
+  for (const auto& [echoes, std_code] :
+       {std::pair{0, 1}, std::pair{2, ClockOffsetReport::kMaxStdCode}}) {
     EgoStateMessage m = MakeEgoState(3, 1, 154, 0, echoes);  // with an offset report
     if (echoes == 0) m.send_delay_ns = 120'000;
     m.offset_report = ClockOffsetReport{63, 0xFFFE, std_code};
@@ -272,6 +310,9 @@ inline std::vector<SwarmMessage> AllExampleMessages() {
   }
   messages.push_back(MakeTimeSync(0, 63, false));
   messages.push_back(MakeTimeSync(63, 0, true));
+  for (uint64_t seed : {300, 301, 302}) {  // one of each shape
+    messages.push_back(MakeAirframe(static_cast<int>(seed % 64), seed));
+  }
   return messages;
 }
 

@@ -112,11 +112,14 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
       if (const auto* e = std::get_if<net::EgoStateMessage>(&m)) {
         ++ego_states_sent;
         observations_sent += static_cast<int>(e->observations.size());
-        wire_bytes.emplace_back(e->stamp_ns, kIpUdpBytes + net::EgoStatePacketBytes(
-                                                               e->observations.size(),
-                                                               e->past_observations.size(),
-                                                               e->echoes.size(),
-                                                               e->offset_report.has_value()));
+        wire_bytes.emplace_back(
+            e->stamp_ns, kIpUdpBytes + net::EgoStatePacketBytes(
+                                           e->observations.size(), e->past_observations.size(),
+                                           e->echoes.size(), e->offset_report.has_value()));
+      }
+      if (const auto* a = std::get_if<net::AirframeMessage>(&m)) {
+        ++airframe_messages_sent;
+        wire_bytes.emplace_back(a->stamp_ns, kIpUdpBytes + net::AirframePacketBytes());
       }
       if (const auto* g = std::get_if<net::GlobalExtrinsicMessage>(&m)) {
         ++extrinsic_messages_sent;
@@ -139,17 +142,18 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
   std::vector<DroneOutput> outputs;
   std::vector<PoseStamped> ground_truth;
   static constexpr size_t kIpUdpBytes = 28;
-  int ego_states_sent = 0;          // one per scan
-  int observations_sent = 0;        // in the states
+  int ego_states_sent = 0;                             // one per scan
+  int observations_sent = 0;                           // in the states
   std::vector<std::pair<int64_t, size_t>> wire_bytes;  // (stamp, bytes on the wire) per message
   int extrinsic_messages_sent = 0;  // the own T_Gi_Gj, about once a second once identified
+  int airframe_messages_sent = 0;   // the own airframe, every airframe_period_s
   std::vector<int64_t> teammate_entry_stamps;  // broadcasts with the teammate's entry
-  double restart_at_s = 1e9;  // the teammate reboots then (new session_start)
-  double mutual_at_s = 1e9;   // from then on the teammate sends its T_Gj_Gi (it identified us)
+  double restart_at_s = 1e9;                   // the teammate reboots then (new session_start)
+  double mutual_at_s = 1e9;    // from then on the teammate sends its T_Gj_Gi (it identified us)
   int indefinite_every_k = 0;  // every k-th broadcast has indefinite covariances (0: none)
   int gravity_messages_delivered = 0;  // GlobalExtrinsic messages with the teammate's gravity
   int relayed_id = -1;  // with mutual_at_s: the teammate also sends its own match of this drone
-  int graph_entries_sent = 0;  // the observer's broadcasts of relayed_id
+  int graph_entries_sent = 0;           // the observer's broadcasts of relayed_id
   int teammate_graph_entries_sent = 0;  // ... of the teammate, as derived
   // The teammate's G after its reboot: restart_shift T_Gj_W (before: T_Gj_W).
   Eigen::Isometry3d restart_shift = Eigen::Isometry3d::Identity();
@@ -168,7 +172,8 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
     while (next_ < broadcast_times_.size() &&
            sim_.StampNs(observer_, broadcast_times_[next_] + latency_s) <= now_ns) {
       const double t = broadcast_times_[next_++];
-      const sim::KinematicState s = sim_.drones()[static_cast<size_t>(teammate_)].trajectory.StateAt(t);
+      const sim::KinematicState s =
+          sim_.drones()[static_cast<size_t>(teammate_)].trajectory.StateAt(t);
       // The teammate's G in its current session.
       const Eigen::Isometry3d T_Gj_W = t < restart_at_s ? T_Gj_W_ : restart_shift * T_Gj_W_;
       net::EgoStateMessage m;
@@ -287,7 +292,10 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
 
 // The first `duration_s` of indoor_3uav for one observer fed by ObserverSink.
 struct ObserverRun {
-  ObserverRun(sim::Scenario scenario, double duration_s, int observer_id, int teammate,
+  ObserverRun(sim::Scenario scenario,
+              double duration_s,
+              int observer_id,
+              int teammate,
               const std::function<void(DroneEstimatorOptions*)>& adjust = {})
       : observer(observer_id) {
     sim::SimulationConfig config = scenario.simulation_config();

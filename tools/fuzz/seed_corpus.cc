@@ -19,7 +19,9 @@ Eigen::Matrix3d Covariance3(double scale) {
   return scale * c;
 }
 
-net::EgoStateMessage EgoState(int sender, int num_observations, int num_past = 0,
+net::EgoStateMessage EgoState(int sender,
+                              int num_observations,
+                              int num_past = 0,
                               int num_echoes = 0) {
   net::EgoStateMessage m;
   m.sender_id = sender;
@@ -94,6 +96,20 @@ net::TimeSyncMessage TimeSync(int sender, int target, bool response) {
   return m;
 }
 
+net::AirframeMessage Airframe(int sender, int shape) {
+  net::AirframeMessage m;
+  m.sender_id = sender;
+  m.stamp_ns = 43'000'000'000;
+  m.reflector_shape = shape;
+  m.reflector_half_extents_m = {0.102, 0.072, 0.025};
+  m.reflector_centre_in_body_m = {0.01, -0.02, -0.035};
+  m.depth_offset_m = 0.07;
+  m.size_m = 0.45;
+  m.min_intensity = 151.0;
+  m.centroid_sigma_m = 0.015;
+  return m;
+}
+
 const char* TypeTag(const net::SwarmMessage& message) {
   switch (net::TypeOf(message)) {
     case net::MessageType::kEgoState:
@@ -102,6 +118,8 @@ const char* TypeTag(const net::SwarmMessage& message) {
       return "global_extrinsic";
     case net::MessageType::kTimeSync:
       return "time_sync";
+    case net::MessageType::kAirframe:
+      return "airframe";
   }
   return "unknown";
 }
@@ -118,11 +136,12 @@ Status WriteFile(const std::string& path, const std::vector<uint8_t>& bytes) {
 }  // namespace
 
 std::vector<net::SwarmMessage> SeedMessages() {
-  return {EgoState(3, 0),        EgoState(3, 1),        EgoState(3, 2),
-          EgoState(7, 5),        EgoState(63, 24),      EgoState(3, 1, 1),      EgoState(3, 1, 0, 2),   EgoState(9, 24, 24, 8),
-          EgoState(9, 24, 24),   GlobalExtrinsic(5, 0),
-          GlobalExtrinsic(5, 1), GlobalExtrinsic(2, 3), GlobalExtrinsic(0, 8),
-          TimeSync(1, 2, false), TimeSync(2, 1, true)};
+  return {EgoState(3, 0),        EgoState(3, 1),         EgoState(3, 2),
+          EgoState(7, 5),        EgoState(63, 24),       EgoState(3, 1, 1),
+          EgoState(3, 1, 0, 2),  EgoState(9, 24, 24, 8), EgoState(9, 24, 24),
+          GlobalExtrinsic(5, 0), GlobalExtrinsic(5, 1),  GlobalExtrinsic(2, 3),
+          GlobalExtrinsic(0, 8), TimeSync(1, 2, false),  TimeSync(2, 1, true),
+          Airframe(4, 0),        Airframe(63, 2)};
 }
 
 Status WriteSeedCorpus(const std::string& dir) {

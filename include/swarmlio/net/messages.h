@@ -1,10 +1,10 @@
 // Inter-drone messages (plain values; SI units; frames in the names, see
 // docs/conventions.md). Wire encoding and sizes: docs/network.md.
 //
-// The codec quantizes (wire version 4, docs/network.md §2.1): stamps exact,
+// The codec quantizes (wire version 7, docs/network.md §2.1): stamps exact,
 // positions float32, quaternions as smallest-three int16 codes, rates
 // float16, observation positions in 2 mm steps, ages of past observations
-// in 0.1 ms steps, covariances as 8-bit log
+// in 0.1 ms steps, airframe lengths in 1 mm steps, covariances as 8-bit log
 // variances and partial correlations. Decoding gives each field back within
 // that precision; the encoder reads only the upper triangle of a covariance,
 // and decoded covariances are symmetric positive definite.

@@ -1,4 +1,4 @@
-// The swarm packet wire format, version 5 (docs/network.md, "Wire format").
+// The swarm packet wire format, version 7 (docs/network.md, "Wire format").
 //
 //   offset size field
 //   0      1    magic 'S' (0x53)
@@ -27,8 +27,8 @@ inline constexpr uint8_t kMagic = 0x53;  // 'S'
 /// 2: gravity in GlobalExtrinsic; 3: quantized payloads, 6-byte header, 16-byte tag;
 /// 4: past observations at the end of EgoState; 5: send delay and state echoes in
 /// EgoState (clock synchronisation without TimeSync packets); 6: an optional clock
-/// offset report after the echoes.
-inline constexpr uint8_t kProtocolVersion = 6;
+/// offset report after the echoes; 7: the Airframe message (type 4).
+inline constexpr uint8_t kProtocolVersion = 7;
 inline constexpr size_t kHeaderBytes = 6;
 inline constexpr size_t kTagBytes = 16;  // HMAC-SHA512-256 truncated to 128 bits
 inline constexpr size_t kPacketOverheadBytes = kHeaderBytes + kTagBytes;
@@ -90,13 +90,13 @@ inline constexpr size_t kStateEchoBytes = 1 + 2 + 2 + 2;
 inline constexpr uint8_t kEchoCountMask = 0x7F;
 inline constexpr uint8_t kOffsetReportFlag = 0x80;
 inline constexpr size_t kOffsetReportBytes = 1 + 2 + 1;
-inline constexpr int64_t kOffsetReportStepNs = 1000;       // 1 us: the residue wraps at 65.536 ms
-inline constexpr int64_t kOffsetReportStdStepNs = 50000;   // 50 us: std up to 12.7 ms
+inline constexpr int64_t kOffsetReportStepNs = 1000;      // 1 us: the residue wraps at 65.536 ms
+inline constexpr int64_t kOffsetReportStdStepNs = 50000;  // 50 us: std up to 12.7 ms
 // Send delay, an echo's send delay and hold: uint16 code = round(ns / kSyncDelayStepNs).
 inline constexpr int64_t kSyncDelayStepNs = 10000;  // 10 us
 inline constexpr int kSendDelayMaxCode = 65534;     // 655.34 ms; 65535 = not known
 inline constexpr int kSendDelayUnknownCode = 65535;
-inline constexpr int kHoldMaxCode = 65535;          // 655.35 ms
+inline constexpr int kHoldMaxCode = 65535;  // 655.35 ms
 /// The code the writer sends for a send delay or hold (rounded; callers check the range).
 constexpr int64_t SyncDelayCode(int64_t ns) {
   return (ns + kSyncDelayStepNs / 2) / kSyncDelayStepNs;
@@ -105,7 +105,9 @@ constexpr int64_t SyncDelayCode(int64_t ns) {
 constexpr int64_t QuantizedSyncDelayNs(int64_t ns) { return SyncDelayCode(ns) * kSyncDelayStepNs; }
 /// The hold of an echo: the send time of the state that carries it (stamp +
 /// the quantized send delay) - the echoed state's arrival. False on overflow.
-inline bool StateEchoHoldNs(int64_t stamp_ns, int64_t send_delay_ns, int64_t arrival_ns,
+inline bool StateEchoHoldNs(int64_t stamp_ns,
+                            int64_t send_delay_ns,
+                            int64_t arrival_ns,
                             int64_t* hold_ns) {
   int64_t sent_ns = 0;
   return !__builtin_add_overflow(stamp_ns, QuantizedSyncDelayNs(send_delay_ns), &sent_ns) &&
@@ -127,31 +129,48 @@ inline constexpr size_t kGlobalExtrinsicFixedBytes = 8 + 12 + CovarianceBytes(3)
 inline constexpr size_t kExtrinsicEntryBytes = 1 + 1 + 6 + 12 + CovarianceBytes(6);
 // TimeSync: target id u8 | kind u8 (0 request, 1 response) | t1 t2 t3 i64
 inline constexpr size_t kTimeSyncBytes = 1 + 1 + 3 * 8;
+// Airframe (version 7): stamp i64 | reflector shape u8 (0 band, 1 box, 2 round) |
+//   min intensity u8 | reflector half extents 3 x u16 (1 mm) |
+//   reflector centre in body 3 x i16 (1 mm) | depth offset u16 (1 mm) |
+//   size u16 (1 mm) | centroid sigma u16 (1 mm)
+// Lengths: code = round(x / kAirframeLengthStepM); non-negative ones as
+// uint16 (0..65.535 m), the centre as int16 (+-32.767 m, the code -32768
+// rejected); min intensity: round(x), 0..255.
+inline constexpr double kAirframeLengthStepM = 0.001;
+inline constexpr int kAirframeLengthMaxCode = 65535;
+inline constexpr int kAirframeCentreMaxCode = 32767;
+inline constexpr int kAirframeMaxShape = 2;
+inline constexpr int kAirframeMaxIntensity = 255;
+inline constexpr size_t kAirframeBytes = 8 + 1 + 1 + 6 + 6 + 2 + 2 + 2;
 
-constexpr size_t EgoStatePacketBytes(size_t num_observations, size_t num_past_observations = 0,
-                                     size_t num_echoes = 0, bool offset_report = false) {
+constexpr size_t EgoStatePacketBytes(size_t num_observations,
+                                     size_t num_past_observations = 0,
+                                     size_t num_echoes = 0,
+                                     bool offset_report = false) {
   return kPacketOverheadBytes + kEgoStateFixedBytes + kStateEchoBytes * num_echoes +
-         (offset_report ? kOffsetReportBytes : 0) +
-         kObservationBytes * num_observations +
+         (offset_report ? kOffsetReportBytes : 0) + kObservationBytes * num_observations +
          (num_past_observations > 0 ? 1 + kPastObservationBytes * num_past_observations : 0);
 }
 constexpr size_t GlobalExtrinsicPacketBytes(size_t num_entries) {
   return kPacketOverheadBytes + kGlobalExtrinsicFixedBytes + kExtrinsicEntryBytes * num_entries;
 }
 constexpr size_t TimeSyncPacketBytes() { return kPacketOverheadBytes + kTimeSyncBytes; }
+constexpr size_t AirframePacketBytes() { return kPacketOverheadBytes + kAirframeBytes; }
 
-static_assert(kEgoStateFixedBytes == 66 && kObservationBytes == 13 &&
-                  kPastObservationBytes == 15 && kStateEchoBytes == 7,
+static_assert(kEgoStateFixedBytes == 66 && kObservationBytes == 13 && kPastObservationBytes == 15 &&
+                  kStateEchoBytes == 7,
               "layout changed: update docs");
 static_assert(kGlobalExtrinsicFixedBytes == 27 && kExtrinsicEntryBytes == 41,
               "layout changed: update docs");
 static_assert(EgoStatePacketBytes(EgoStateMessage::kMaxObservations,
                                   EgoStateMessage::kMaxPastObservations,
-                                  EgoStateMessage::kMaxEchoes, true) <= kMaxPacketBytes);
+                                  EgoStateMessage::kMaxEchoes,
+                                  true) <= kMaxPacketBytes);
 static_assert(EgoStateMessage::kMaxEchoes <= kEchoCountMask, "the echo count travels in 7 bits");
 static_assert(EgoStateMessage::kMaxPastObservations <= 255, "the past count travels in one byte");
 static_assert(GlobalExtrinsicPacketBytes(GlobalExtrinsicMessage::kMaxEntries) <= kMaxPacketBytes);
 static_assert(TimeSyncPacketBytes() <= kMaxPacketBytes);
+static_assert(kAirframeBytes == 28, "layout changed: update docs");
 static_assert(EgoStateMessage::kMaxObservations < 32, "the count travels in 5 bits");
 static_assert(kMaxSwarmSize <= 255, "ids travel as one byte");
 

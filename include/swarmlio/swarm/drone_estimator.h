@@ -39,6 +39,7 @@
 #include "swarmlio/sensors/lidar_options.h"
 #include "swarmlio/swarm/sensor_record.h"
 #include "swarmlio/swarm/swarm_options.h"
+#include "swarmlio/teammate/airframe.h"
 #include "swarmlio/teammate/teammate_detector.h"
 
 namespace swarmlio::swarm {
@@ -47,19 +48,22 @@ struct DroneEstimatorOptions {
   lio::OdometryOptions odometry;
   teammate::TeammateDetectorOptions teammate;
   SwarmOptions swarm;
+  /// This drone's own body, announced to the teammates every
+  /// swarm.experimental.airframe_period_s (YAML `airframe:` of a drone entry).
+  teammate::AirframeDescription airframe;
   std::string Validate() const;
 };
 
 /// One identified teammate's state in this drone's frame G_i at a scan end.
 struct TeammateEstimate {
   int drone_id = -1;
-  GlobalExtrinsic T_Gi_Gj;                                           // from the state
+  GlobalExtrinsic T_Gi_Gj;  // from the state
   Eigen::Matrix<double, 6, 6> extrinsic_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool have_pose = false;  // a recent enough broadcast state exists
   Eigen::Quaterniond q_Gi_bj = Eigen::Quaterniond::Identity();  // j's body in G_i
   Eigen::Vector3d p_bj_in_Gi = Eigen::Vector3d::Zero();
   Eigen::Vector3d v_bj_in_Gi = Eigen::Vector3d::Zero();
-  bool seen = false;        // a LiDAR observation of j in this scan
+  bool seen = false;             // a LiDAR observation of j in this scan
   int active_observations = 0;   // fused in this scan
   int passive_observations = 0;  // fused in this scan
 };
@@ -67,38 +71,39 @@ struct TeammateEstimate {
 /// How a teammate was identified.
 struct IdentificationEvent {
   int drone_id = -1;
-  int64_t stamp_ns = 0;       // own clock
-  std::string method;         // "trajectory_match", "teammate_match" (it identified me) or
-                              // "graph" (through teammate via_drone_id's own match)
-  int via_drone_id = -1;      // "graph": the teammate whose T_Gj_Gk was composed
+  int64_t stamp_ns = 0;   // own clock
+  std::string method;     // "trajectory_match", "teammate_match" (it identified me) or
+                          // "graph" (through teammate via_drone_id's own match)
+  int via_drone_id = -1;  // "graph": the teammate whose T_Gj_Gk was composed
   double mean_residual_m = 0.0;
   GlobalExtrinsic initial_T_Gi_Gj;
 };
 
 struct DroneOutput {
   lio::ScanOutput ego;
-  std::vector<TeammateEstimate> teammates;  // every teammate in the state
+  std::vector<TeammateEstimate> teammates;           // every teammate in the state
   std::vector<IdentificationEvent> identifications;  // in this scan
   std::vector<int> removed_teammates;                // left the state in this scan
-  int active_observations = 0;    // fused
-  int passive_observations = 0;   // fused
-  int gravity_alignments = 0;     // teammates' gravity fused
-  int rejected_observations = 0;  // gated out or unusable (no recent message)
-  bool extrinsics_frozen = false; // degeneracy policy applied
-  int num_detector_points = 0;    // full-resolution points given to the detector
+  int active_observations = 0;                       // fused
+  int passive_observations = 0;                      // fused
+  int gravity_alignments = 0;                        // teammates' gravity fused
+  int rejected_observations = 0;                     // gated out or unusable (no recent message)
+  bool extrinsics_frozen = false;                    // degeneracy policy applied
+  int num_detector_points = 0;                       // full-resolution points given to the detector
 };
 
 struct DroneEstimatorCounters {
   int64_t messages_received = 0;
-  int64_t messages_ignored = 0;   // own, unknown type, non-finite, stale, or a TimeSync for another drone
+  int64_t messages_ignored = 0;   // own, unknown type, non-finite, stale, a TimeSync for another
+                                  // drone, or an invalid airframe
   int64_t teammate_restarts = 0;  // session_start changed
   int64_t messages_unsynchronized = 0;  // states of a teammate whose clock offset is not known yet
   int64_t identifications = 0;
   int64_t teammates_removed = 0;
   int64_t active_fused = 0;
   int64_t passive_fused = 0;
-  int64_t passive_repeated = 0;     // of passive_fused: sent again after the first message (lost)
-  int64_t repeats_duplicate = 0;    // observations of this drone received twice: used once
+  int64_t passive_repeated = 0;   // of passive_fused: sent again after the first message (lost)
+  int64_t repeats_duplicate = 0;  // observations of this drone received twice: used once
   // Ignored: T_Gj_Gi from before this session, T_Gj_Gk from before k restarted.
   int64_t extrinsics_stale = 0;
   int64_t gravity_fused = 0;
@@ -112,17 +117,20 @@ struct DroneEstimatorCounters {
   int64_t sent_observation_bytes = 0;
   int64_t sent_repeat_bytes = 0;
   int64_t sent_extrinsic_bytes = 0;
+  int64_t sent_airframe_bytes = 0;  // the own airframe's announcements
   int64_t observations_unsent = 0;
 };
 
 /// One line for the tools' summaries: "broadcast: N B states, ... B
-/// extrinsics" (the sent_* counters and observations_unsent), starting with
+/// extrinsics, ... B airframe" (the sent_* counters and observations_unsent), starting with
 /// `indent`, ending with a newline.
 std::string FormatBroadcastCounters(const DroneEstimatorCounters& c, const std::string& indent);
 
 class DroneEstimator {
  public:
-  static Status Create(int self_id, const DroneEstimatorOptions& options, const LidarOptions& lidar,
+  static Status Create(int self_id,
+                       const DroneEstimatorOptions& options,
+                       const LidarOptions& lidar,
                        std::unique_ptr<DroneEstimator>* estimator);
   ~DroneEstimator();
 

@@ -135,6 +135,11 @@ struct SwarmOptions {
   /// The own T_Gi_Gj estimates are broadcast this often (0 = never) [s];
   /// new ones at once. Entries per broadcast: broadcast_budget.
   double extrinsic_broadcast_period_s = 1.0;
+  /// This drone's airframe (DroneEstimatorOptions::airframe) is announced to
+  /// the teammates with the first scan's messages and then this often, on
+  /// the own clock (0 = never: teammates detect it with their own defaults).
+  /// 50 B per packet, paid from the byte budget like the state [s].
+  double airframe_period_s = 2.0;
   /// The bytes this drone puts on the wire: a budget shared by the optional
   /// content of its messages (docs/swarm.md "Broadcast budget").
   BroadcastBudgetOptions broadcast_budget;
@@ -149,7 +154,8 @@ struct SwarmOptions {
     v("fuse_gravity", fuse_gravity,
       FieldSpec::Doc("fuse the teammates' broadcast gravity with the own (tilt of T_Gi_Gj)"));
     v("synchronize_clocks", synchronize_clocks,
-      FieldSpec::Doc("estimate teammates' clock offsets online and map their stamps to the own clock"));
+      FieldSpec::Doc(
+          "estimate teammates' clock offsets online and map their stamps to the own clock"));
     v("clock_sync", clock_sync, FieldSpec::Doc("clock synchronisation (docs/network.md)"));
     v("teammate_timeout_s", teammate_timeout_s,
       FieldSpec::Positive("s", "unseen and unheard this long: removed from the state"));
@@ -163,7 +169,9 @@ struct SwarmOptions {
       x("gravity_alignment_sigma_m_s2", gravity_alignment_sigma_m_s2,
         FieldSpec::Positive("m/s^2", "1-sigma added to a teammate's gravity covariance"));
       x("observation_information_share", observation_information_share,
-        FieldSpec::InRange(0.01, 1.0, "", "share of a mutual observation's information per use (active, passive)"));
+        FieldSpec::InRange(
+            0.01, 1.0, "",
+            "share of a mutual observation's information per use (active, passive)"));
       x("time_compensation", time_compensation,
         FieldSpec::Doc("predict teammate states / shift passive observations to the update time"));
       x("max_message_age_s", max_message_age_s,
@@ -181,16 +189,22 @@ struct SwarmOptions {
       x("skip_degenerate_teammates", skip_degenerate_teammates,
         FieldSpec::Doc("do not fuse observations involving a teammate that reports degeneracy"));
       x("repeat_observations", repeat_observations,
-        FieldSpec::Doc("none | degenerate_teammates | all: observations sent again with the next state"));
+        FieldSpec::Doc(
+            "none | degenerate_teammates | all: observations sent again with the next state"));
       x("mutual_identification", mutual_identification,
-        FieldSpec::Doc("add a teammate that identified this drone, with the inverse of its T_Gj_Gi"));
+        FieldSpec::Doc(
+            "add a teammate that identified this drone, with the inverse of its T_Gj_Gi"));
       x("graph_identification", graph_identification,
         FieldSpec::Doc("add a teammate that a known teammate identified, through its T_Gj_Gk"));
       x("graph_through_derived", graph_through_derived,
-        FieldSpec::Doc("a graph-derived teammate may relay once the teammates it came through left or "
-                       "its block was fused graph_derived_min_observations times"));
+        FieldSpec::Doc(
+            "a graph-derived teammate may relay once the teammates it came through left or "
+            "its block was fused graph_derived_min_observations times"));
       x("graph_derived_min_observations", graph_derived_min_observations,
-        FieldSpec::AtLeast(0, "", "own observations fused into a graph-derived block before it may relay"));
+        FieldSpec::AtLeast(
+            0, "", "own observations fused into a graph-derived block before it may relay"));
+      x("airframe_period_s", airframe_period_s,
+        FieldSpec::InRange(0.0, 3600.0, "s", "announce the own airframe this often (0 = never)"));
     });
   }
   std::string Validate() const { return config::ValidateFields(*this); }
