@@ -11,6 +11,7 @@ swarm::DroneEstimatorOptions EstimatorOptionsFor(const DroneInput& drone,
   options.odometry.initialization = initialization;
   options.teammate = drone.teammate;
   options.swarm = drone.swarm;
+  options.airframe = drone.airframe;
   return options;
 }
 

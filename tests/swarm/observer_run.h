@@ -54,6 +54,7 @@ inline sim::Scenario IndoorScenario() {
 inline DroneEstimatorOptions OptionsFor(const sim::DroneConfig& d) {
   DroneEstimatorOptions o;
   o.odometry = swarmlio::testing::GivenDroneInput(d).odometry;
+  o.airframe = swarmlio::testing::GivenDroneInput(d).airframe;
   // The sinks below hand over the teammate's states stamped on one clock
   // without TimeSync exchanges; clock synchronisation has its own test.
   o.swarm.synchronize_clocks = false;
@@ -67,6 +68,7 @@ inline driver::DroneInput InputFor(const sim::DroneConfig& d, const DroneEstimat
   input.odometry = o.odometry;
   input.teammate = o.teammate;
   input.swarm = o.swarm;
+  input.airframe = o.airframe;
   return input;
 }
 
