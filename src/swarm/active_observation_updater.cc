@@ -6,6 +6,7 @@
 #include "swarmlio/common/time.h"
 
 #include "factors/active_observation_factor.h"
+#include "innovation_noise_scale.h"
 #include "observation_terms.h"
 
 namespace swarmlio::swarm::internal {
@@ -36,16 +37,21 @@ void ActiveObservationUpdater::AddTerms(const UpdaterScan& scan, ObservationGate
     const PredictedTeammate j = Predict(m, so.time_compensation ? age : 0.0);
     const GlobalExtrinsic& T = x.teammate(o.drone_id);
     const double share = ObservationShare(so, scan.previous_scan_degenerate, m.degenerated);
+    TeammateInfo& info = it->second;
+    const Eigen::Matrix3d R = info.observation_noise_scale * Regularized<3>(o.covariance_m2);
     auto factor = std::make_unique<ActiveObservationFactor>(
-        o.p_bj_in_bi, j.p_bj_in_Gj, Regularized<3>(o.covariance_m2) / share,
-        Regularized<3>(j.cov_p), R_Gi_bi, T.R_Ga_Gb());
+        o.p_bj_in_bi, j.p_bj_in_Gj, R / share, Regularized<3>(j.cov_p), R_Gi_bi, T.R_Ga_Gb());
     const Eigen::Vector3d e = factor->Predict(x.ego, T) - o.p_bj_in_bi;
     const Eigen::Matrix3d S = factor->covariance();
+    if (so.noise_adaptation_rate > 0.0 && scan.P != nullptr && !gate->frozen()) {
+      const double nis = ActiveObservationNis(*factor, x, *scan.P, o.drone_id, e, R / share, R);
+      info.observation_noise_scale = UpdatedNoiseScale(info.observation_noise_scale, nis, so);
+    }
     if (gate->Add(std::move(factor), o.drone_id, e, S)) {
       ++report->active;
       ++report->fused_by_teammate[o.drone_id].first;
       ++counters_->active_fused;
-      if (!gate->frozen()) ++it->second.observations_fused;
+      if (!gate->frozen()) ++info.observations_fused;
     }
   }
 }

@@ -210,6 +210,7 @@ Status DroneEstimator::FrontEnd(lio::ScanContext* scan, lio::UpdateRequest* requ
   internal::UpdaterScan u;
   u.t_k = t_k;
   u.x = &x;
+  u.P = &scan->P;
   u.poses = scan->poses;
   u.fusion_enabled = fusion_enabled_;
   u.previous_scan_degenerate = degenerate;

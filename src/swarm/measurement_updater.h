@@ -20,6 +20,7 @@ namespace swarmlio::swarm::internal {
 struct UpdaterScan {
   int64_t t_k = 0;                        // the state time (scan end, own clock)
   const SwarmState* x = nullptr;          // the prediction, teammate blocks current
+  const Eigen::MatrixXd* P = nullptr;     // its covariance (layout of x)
   const std::vector<lio::ImuPose>* poses = nullptr;  // the propagated poses over the scan
   bool fusion_enabled = true;             // DroneEstimator::SetFusion
   bool previous_scan_degenerate = false;  // the own last updated scan

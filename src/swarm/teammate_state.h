@@ -46,6 +46,9 @@ struct TeammateInfo {
   std::map<int, int64_t> derived_through;
   // Own active and passive observations fused into its block since it was added.
   int observations_fused = 0;
+  // Scale of its active observations' covariance from the innovations
+  // (innovation_noise_scale.h); 1 while noise_adaptation_rate is 0.
+  double observation_noise_scale = 1.0;
   // j's clock stamps of the observations of this drone already taken (j
   // repeats observations, SwarmOptions::repeat_observations): the newest few.
   std::deque<int64_t> taken_observation_stamps;

@@ -103,6 +103,13 @@ struct SwarmOptions {
   /// Observations farther than this many sigma from the prediction are
   /// rejected before the update (chi-square gate on 3 dof; 0 = off).
   double gate_sigma = 5.0;
+  /// Per-teammate scale of the active observation covariance from the
+  /// innovations (docs/swarm.md "Observation noise from the innovations"):
+  /// the weight of each observation in the scale's update (0 = off), and the
+  /// scale's range.
+  double noise_adaptation_rate = 0.0;
+  double min_noise_scale = 0.5;
+  double max_noise_scale = 10.0;
   DegeneracyPolicy degeneracy_policy = DegeneracyPolicy::kConsiderExtrinsics;
   /// Observations that involve a teammate whose last message says its scan
   /// was degenerate are not fused while this drone's own last scan was not
@@ -183,6 +190,14 @@ struct SwarmOptions {
       x("init_rotation_sigma_floor_rad", init_rotation_sigma_floor_rad,
         FieldSpec::Positive("rad", "smallest initial 1-sigma of R_Gi_Gj"));
       x("gate_sigma", gate_sigma, FieldSpec::AtLeast(0.0, "", "Mahalanobis gate (0 = off)"));
+      x("noise_adaptation_rate", noise_adaptation_rate,
+        FieldSpec::InRange(0.0, 1.0, "",
+                           "weight of each innovation in the per-teammate observation noise "
+                           "scale (0 = off)"));
+      x("min_noise_scale", min_noise_scale,
+        FieldSpec::Positive("", "smallest per-teammate observation noise scale"));
+      x("max_noise_scale", max_noise_scale,
+        FieldSpec::Positive("", "largest per-teammate observation noise scale"));
       x("degeneracy_policy", degeneracy_policy,
         FieldSpec::Doc("consider_extrinsics | freeze_extrinsics | estimate_all, after a "
                        "degenerate scan"));
@@ -207,7 +222,13 @@ struct SwarmOptions {
         FieldSpec::InRange(0.0, 3600.0, "s", "announce the own airframe this often (0 = never)"));
     });
   }
-  std::string Validate() const { return config::ValidateFields(*this); }
+  std::string Validate() const {
+    std::string error = config::ValidateFields(*this);
+    if (error.empty() && min_noise_scale > max_noise_scale) {
+      error = "min_noise_scale: must not exceed max_noise_scale";
+    }
+    return error;
+  }
 };
 
 }  // namespace swarmlio::swarm
