@@ -151,7 +151,10 @@ TEST_F(WindowSwarmTest, WindowFusesTheTeammatesAndEqualsTheFilterAtOneState) {
     EXPECT_EQ(one[i].identified, 2);
     EXPECT_GT(one[i].fused, 100);
     EXPECT_LT(max_dp, 7e-3);
-    EXPECT_LT(max_dT_m, 0.015);
+    // 0.017 m measured (uav3; 0.007 m before the teammates' announced band
+    // model moved the observations with the relative attitude, which each back
+    // end predicts a little differently).
+    EXPECT_LT(max_dT_m, 0.035);
     EXPECT_LT(max_dT_deg, 0.4);
 
     ExtrinsicDifference(filter[i], five[i], &max_dT_m, &max_dT_deg);
