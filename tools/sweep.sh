@@ -14,7 +14,8 @@
 # as `<report> OUT` when every run finished (REPORT=0 skips it).
 # Environment: BUILD_DIR (default build), JOBS (local: parallel jobs, default
 # every core), SBATCH_ARGS (slurm: extra sbatch options, e.g. "-p lab -t 2:00:00"),
-# SLURM_WAIT=1 (slurm: wait for the aggregation job to finish).
+# SLURM_WAIT=1 (slurm: wait for the aggregation job to finish), SWEEP_RUNNER
+# (the per-run script instead of tools/sweep/run_one.sh; the tests' stub).
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -30,7 +31,8 @@ expand() {
   local sweep="$1" out="$2"
   local before=""
   [[ -f "$out/runs.jobs" ]] && before="$(cat "$out/sims.jobs" "$out/runs.jobs")"
-  "$SWEEP_TOOL" expand --sweep "$sweep" --out "$out" --root "$ROOT" --build "$BUILD_DIR" >&2
+  "$SWEEP_TOOL" expand --sweep "$sweep" --out "$out" --root "$ROOT" --build "$BUILD_DIR" \
+    ${SWEEP_RUNNER:+--runner "$SWEEP_RUNNER"} >&2
   if [[ "$before" != "$(cat "$out/sims.jobs" "$out/runs.jobs")" ]]; then
     rm -f "$out/sims.joblog" "$out/runs.joblog"
   fi

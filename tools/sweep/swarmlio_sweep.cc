@@ -64,6 +64,12 @@ Status RunExpand() {
   SWARMLIO_RETURN_IF_ERROR(WriteRunList(options.out_dir + "/runs.tsv", entries));
   SWARMLIO_RETURN_IF_ERROR(WriteLines(options.out_dir + "/name", {sweep.sweep.name}));
   SWARMLIO_RETURN_IF_ERROR(WriteLines(options.out_dir + "/report", {sweep.sweep.report}));
+  // The sweep file as the reports name it: relative to the source tree when inside it.
+  const std::string relative =
+      std::filesystem::path(Absolute(FLAGS_sweep)).lexically_relative(options.root).string();
+  SWARMLIO_RETURN_IF_ERROR(WriteLines(
+      options.out_dir + "/sweep.file",
+      {relative.empty() || relative.rfind("..", 0) == 0 ? Absolute(FLAGS_sweep) : relative}));
   if (!std::filesystem::equivalent(FLAGS_sweep, options.out_dir + "/sweep.yaml", ec)) {
     std::filesystem::copy_file(FLAGS_sweep, options.out_dir + "/sweep.yaml",
                              std::filesystem::copy_options::overwrite_existing, ec);
