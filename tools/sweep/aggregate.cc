@@ -122,13 +122,24 @@ Status Summarize(const std::vector<RunEntry>& runs, Summary* summary) {
       }
     }
   }
-  // Rows grouped by variant (sweep order), then scenario and drone (first seen), figure, mode.
-  std::stable_sort(order.begin(), order.end(), [&](const Key& a, const Key& b) {
-    const auto rank = [&](const std::string& v) {
-      return std::find(summary->variants.begin(), summary->variants.end(), v) - summary->variants.begin();
-    };
-    return rank(std::get<0>(a)) < rank(std::get<0>(b));
-  });
+  // Rows grouped by variant (sweep order), scenario and drone (first seen),
+  // figure (SummaryFigures order), mode (swarm first).
+  std::map<std::string, size_t> first_seen;
+  for (const Key& key : order) {
+    first_seen.emplace(std::get<1>(key), first_seen.size());
+    first_seen.emplace(std::get<1>(key) + "\n" + std::get<2>(key), first_seen.size());
+  }
+  const auto rank = [&](const Key& k) {
+    const auto& v = summary->variants;
+    const auto& f = SummaryFigures();
+    return std::make_tuple(std::find(v.begin(), v.end(), std::get<0>(k)) - v.begin(),
+                           first_seen[std::get<1>(k)],
+                           first_seen[std::get<1>(k) + "\n" + std::get<2>(k)],
+                           std::find(f.begin(), f.end(), std::get<3>(k)) - f.begin(),
+                           std::get<4>(k) == "swarm" ? 0 : 1);
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](const Key& a, const Key& b) { return rank(a) < rank(b); });
   for (const Key& key : order) {
     summary->rows.push_back({std::get<0>(key), std::get<1>(key), std::get<2>(key), std::get<3>(key),
                              std::get<4>(key), ComputeSeedStats(values[key])});

@@ -15,7 +15,7 @@ namespace {
 std::string Cell(const SeedStats* s) {
   if (s == nullptr || s->n == 0) return "n/a | | |";
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "%.4g +- %.2g | %.4g-%.4g | %.4g-%.4g | %d", s->mean, s->std,
+  std::snprintf(buf, sizeof(buf), "%.4g +- %.2g | %.4g-%.4g | [%.4g, %.4g] | %d", s->mean, s->std,
                 s->min, s->max, s->ci95_lo, s->ci95_hi, s->n);
   return buf;
 }
