@@ -34,7 +34,7 @@ expand() {
   "$SWEEP_TOOL" expand --sweep "$sweep" --out "$out" --root "$ROOT" --build "$BUILD_DIR" \
     ${SWEEP_RUNNER:+--runner "$SWEEP_RUNNER"} >&2
   if [[ "$before" != "$(cat "$out/sims.jobs" "$out/runs.jobs")" ]]; then
-    rm -f "$out/sims.joblog" "$out/runs.joblog"
+    rm -f "$out/jobs.joblog"
   fi
 }
 
@@ -61,10 +61,12 @@ run_local() {
   command -v parallel >/dev/null || { echo "GNU parallel is missing (apt-get install parallel)" >&2; exit 1; }
   local jobs="${JOBS:-100%}"
   log "$(wc -l < "$out/sims.jobs") simulations, then $(wc -l < "$out/runs.jobs") runs; GNU parallel -j $jobs"
-  # --resume-failed: jobs in the job log that ended with status 0 are skipped;
-  # the others (failed, or killed by an interruption) run again.
-  parallel --will-cite -j "$jobs" --joblog "$out/sims.joblog" --resume-failed < "$out/sims.jobs" || rc=1
-  parallel --will-cite -j "$jobs" --joblog "$out/runs.joblog" --resume-failed < "$out/runs.jobs" || rc=1
+  # One list, simulations first, so that no core waits at a barrier between
+  # the two (a run whose simulation is still in progress waits on its lock).
+  # --resume-failed: jobs in the job log that ended with status 0 are
+  # skipped; the others (failed, or killed by an interruption) run again.
+  cat "$out/sims.jobs" "$out/runs.jobs" |
+    parallel --will-cite -j "$jobs" --joblog "$out/jobs.joblog" --resume-failed || rc=1
   aggregate "$out" || rc=1
   return $rc
 }

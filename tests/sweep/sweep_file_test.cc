@@ -67,7 +67,8 @@ TEST(SweepFile, ReadsTheSeedOfAScenarioFile) {
 }
 
 TEST(SweepFile, TheShippedSweepFilesLoad) {
-  for (const char* name : {"scenarios", "window_comparison", "identification", "lossy_network"}) {
+  for (const char* name : {"scenarios", "window_comparison", "identification", "lossy_network",
+                           "ablation_no_angular_noise"}) {
     SweepFile sweep;
     const Status s = LoadSweep(std::string(SWARMLIO_SOURCE_DIR) + "/configs/sweeps/" + name + ".yaml",
                                SWARMLIO_SOURCE_DIR, &sweep);
