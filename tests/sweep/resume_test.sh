@@ -28,12 +28,12 @@ STUB_LOG="$WORK/first.log" STUB_SLEEP_S=1 setsid bash "$ROOT/tools/sweep.sh" loc
   > "$WORK/first.out" 2>&1 &
 pid=$!
 for _ in $(seq 100); do
-  [[ $(find "$out/runs" -name done 2>/dev/null | wc -l) -ge 2 ]] && break
+  [[ $(find "$out/runs" -name 'done' 2>/dev/null | wc -l) -ge 2 ]] && break
   sleep 0.1
 done
 kill -KILL -- -"$pid" 2>/dev/null || true
 wait "$pid" 2>/dev/null || true
-mapfile -t finished < <(find "$out/runs" -name done -printf '%h\n' | sort)
+mapfile -t finished < <(find "$out/runs" -name 'done' -printf '%h\n' | sort)
 echo "finished before the interruption: ${#finished[@]} of 8"
 [[ ${#finished[@]} -ge 2 && ${#finished[@]} -lt 8 ]] || fail "${#finished[@]} runs finished before the stop"
 STUB_LOG="$WORK/second.log" bash "$ROOT/tools/sweep.sh" local "$sweep" "$out"

@@ -87,7 +87,7 @@ while squeue -h -j "$job" 2>/dev/null | grep -q .; do
   sleep 1
 done
 [[ -f "$WORK/slurm/summary.tsv" ]] || fail "no summary.tsv from the Slurm sweep: $(cat "$WORK"/slurm/slurm/logs/* 2>/dev/null | tail -n 20)"
-[[ $(find "$WORK/slurm/runs" -name done | wc -l) -eq 8 ]] || fail "not 8 finished runs"
+[[ $(find "$WORK/slurm/runs" -name 'done' | wc -l) -eq 8 ]] || fail "not 8 finished runs"
 cmp "$WORK/local/summary.tsv" "$WORK/slurm/summary.tsv" || {
   diff "$WORK/local/summary.tsv" "$WORK/slurm/summary.tsv" | head -n 20; fail "the tables differ"; }
 echo "PASS: Slurm array sweep done in $((SECONDS - start)) s; summary.tsv equals the GNU parallel run's"
