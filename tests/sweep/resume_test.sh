@@ -33,6 +33,14 @@ for _ in $(seq 100); do
 done
 kill -KILL -- -"$pid" 2>/dev/null || true
 wait "$pid" 2>/dev/null || true
+# GNU parallel starts each job in a process group of its own: the runs still
+# in flight are stopped by their ids (stub_run.sh writes <run folder>.pid).
+for f in "$out"/runs/*/*/*/*.pid; do
+  [[ -f "$f" ]] && kill -KILL "$(cat "$f")" 2>/dev/null || true
+done
+# A run that started just before the stop may have escaped both; let it end
+# (it then counts as finished).
+sleep 1.5
 mapfile -t finished < <(find "$out/runs" -name 'done' -printf '%h\n' | sort)
 echo "finished before the interruption: ${#finished[@]} of 8"
 [[ ${#finished[@]} -ge 2 && ${#finished[@]} -lt 8 ]] || fail "${#finished[@]} runs finished before the stop"

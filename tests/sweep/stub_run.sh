@@ -19,6 +19,7 @@ done
 echo "start $run_dir" >> "${STUB_LOG:-/dev/null}"
 rm -rf "$run_dir"
 mkdir -p "$run_dir"
+echo $$ > "$run_dir.pid"  # the resume test stops runs in flight by this id
 sleep "${STUB_SLEEP_S:-0}"
 awk -v s="$seed" -v k="$scale" -v single="$([[ $mode == single ]] && echo 1 || echo 0)" 'BEGIN {
   print "drone,ape_rmse_m,drift_percent,nees_position,time_median_ms,ground_truth_frame"
@@ -27,3 +28,4 @@ awk -v s="$seed" -v k="$scale" -v single="$([[ $mode == single ]] && echo 1 || e
            0.1 * d + 0.01 * (s % 7), 2 + (s % 5) * 0.25, 10 + d + single
 }' > "$run_dir/metrics.csv"
 echo "stub" > "$run_dir/done"
+rm -f "$run_dir.pid"
