@@ -47,7 +47,7 @@ for name in "${scenarios[@]}"; do
           > "$dir/swarm.log" 2>&1 || { echo "replay failed: $dir/swarm.log" >&2; exit 1; }
     fi
     [[ -f "$dir/sim/swarm.yaml" && -f "$dir/swarm/metrics.csv" ]] ||
-      { echo "missing $dir/sim or $dir/swarm: run SEED_OFFSETS=0 tools/run_scenarios.sh $name first" >&2; exit 1; }
+      { echo "missing $dir/sim or $dir/swarm (or run the same grid as a sweep: tools/sweep.sh local configs/sweeps/lossy_network.yaml)" >&2; exit 1; }
     for seed in $SEEDS; do
       cfg="$dir/lossy_seed$seed.yaml"
       printf 'network:\n  seed: %s\n  default_link: {latency_mean_s: %s, jitter_std_s: 0.01, loss_probability: %s}\n' \

@@ -1,212 +1,30 @@
 #!/usr/bin/env bash
-# Regenerates docs/results_scenarios.md: every scenario in configs/scenarios/
-# x several scenario seeds x {swarm, single-agent}: simulate, replay (swarm
-# mode through the simulated network, and the single-agent ablation), and
-# tabulate per drone the mean and spread over the seeds. Needs a Release
-# build in $BUILD_DIR (tools/swarmlio.sh setup).
+# Regenerates docs/results_scenarios.md and the headline of docs/results.md:
+# the scenarios sweep (configs/sweeps/scenarios.yaml: every scenario x its
+# file seed plus the held-out offsets x {swarm, single-agent}) through GNU
+# parallel on every core, then its report (tools/sweep/scenarios_report.sh).
+# The same as
 #
-#   tools/run_scenarios.sh                 # all scenarios, results in results/scenarios/
-#   tools/run_scenarios.sh indoor_3uav     # only the named ones
-#   SEED_OFFSETS="0" tools/run_scenarios.sh    # only the seed in each file (tuning data)
-#   IMPERFECTIONS=ideal tools/run_scenarios.sh # the simulator preset (default: the scenario's)
-#   # An ablation: the realistic preset without one imperfection, in its own
-#   # table (IMPERFECTIONS_YAML is appended to each scenario as its
-#   # `imperfections:` map, docs/simulator.md; SINGLE_AGENT=0 skips the
-#   # single-agent replays):
-#   IMPERFECTIONS_YAML='{preset: realistic, lidar: {angular_noise_deg: 0}}' SINGLE_AGENT=0 \
-#     DOC=docs/results_ablation.md OUT=/tmp/ablation tools/run_scenarios.sh exploration
+#   tools/sweep.sh local configs/sweeps/scenarios.yaml [OUT]
 #
-# Seeds: the scenario file's own seed plus each offset in SEED_OFFSETS
-# (default "1000 2000 3000 4000", the held-out seeds of docs/evaluation.md
-# "Tuning and held-out seeds"); the seed drives the sensor noise, the
-# calibration error handed to the estimator and the random targets of the
-# excitation flights. Every table also goes into the headline table of
-# docs/results.md (tools/results_headline.sh; HEADLINE=0 skips it).
-#
-# The swarm replay runs on core 0 and the single-agent replay at the same time
-# on core 1 (`taskset`), so each per-scan time is measured on a core of its
-# own.
+# (docs/sweeps.md). Re-running it skips the finished runs. Other grids (other
+# scenarios, seeds, an imperfections map, estimator variants) are sweep files
+# of their own; the former environment knobs are keys there:
+#   SEED_OFFSETS -> sweep.seed_offsets, scenario names -> sweep.scenarios,
+#   IMPERFECTIONS / IMPERFECTIONS_YAML -> variants[].imperfections,
+#   SINGLE_AGENT=0 -> sweep.modes: [swarm], DOC / RESULTS_DOC / HEADLINE -> the
+#   report's environment (tools/sweep/scenarios_report.sh).
 set -euo pipefail
-
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
-OUT="${OUT:-$ROOT/results/scenarios}"
-DOC="${DOC:-$ROOT/docs/results_scenarios.md}"
-SEED_OFFSETS="${SEED_OFFSETS:-1000 2000 3000 4000}"
-HEADLINE="${HEADLINE:-1}"
-RESULTS_DOC="${RESULTS_DOC:-$ROOT/docs/results.md}"
-IMPERFECTIONS="${IMPERFECTIONS:-}"
-IMPERFECTIONS_YAML="${IMPERFECTIONS_YAML:-}"
-SINGLE_AGENT="${SINGLE_AGENT:-1}"
-if [[ -n "$IMPERFECTIONS" && -n "$IMPERFECTIONS_YAML" ]]; then
-  echo "set IMPERFECTIONS or IMPERFECTIONS_YAML, not both" >&2
-  exit 1
-fi
-SIM="$BUILD_DIR/tools/sim/swarmlio_sim"
-REPLAY="$BUILD_DIR/tools/replay/swarmlio_replay"
-
-# The commit of the source tree when the run starts (the binaries in BUILD_DIR
-# must be built from it; the tables name it).
-COMMIT="$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)"
-git -C "$ROOT" diff --quiet HEAD 2>/dev/null || COMMIT="$COMMIT (with uncommitted changes)"
-
-for tool in "$SIM" "$REPLAY"; do
-  [[ -x "$tool" ]] || { echo "missing $tool: run tools/swarmlio.sh setup first" >&2; exit 1; }
+for knob in SEED_OFFSETS IMPERFECTIONS IMPERFECTIONS_YAML SINGLE_AGENT; do
+  if [[ -n "${!knob:-}" ]]; then
+    echo "$knob is now a key of a sweep file (see the head of $0 and docs/sweeps.md)" >&2
+    exit 2
+  fi
 done
-
 if [[ $# -gt 0 ]]; then
-  scenarios=("$@")
-else
-  scenarios=()
-  for f in "$ROOT"/configs/scenarios/*.yaml; do scenarios+=("$(basename "$f" .yaml)"); done
+  echo "scenario names are now sweep.scenarios of a sweep file (docs/sweeps.md)" >&2
+  exit 2
 fi
-
-# The seed in a scenario file (block `  seed: N` or inline `seed: N` in the
-# `scenario:` line).
-file_seed() {
-  sed -nE '/^scenario:/,/^[a-z]/{s/.*seed: *([0-9]+).*/\1/p}' "$1" | head -n1
-}
-
-# stats <column> <drone> <csv files...>: "mean +- std (min-max)" of a column
-# of the metrics.csv files for one drone.
-stats() {
-  local column="$1" drone="$2"
-  shift 2
-  if [[ $# -eq 0 ]]; then printf "n/a"; return; fi
-  awk -F, -v col="$column" -v d="$drone" '
-    FNR == 1 { for (i = 1; i <= NF; ++i) if ($i == col) c = i; next }
-    $1 == d && c > 0 && $c ~ /^[-+0-9.eE]+$/ { v = $c + 0; n++; s += v; ss += v * v;
-                       if (n == 1 || v < lo) lo = v; if (n == 1 || v > hi) hi = v }
-    END {
-      if (n == 0) { printf "n/a"; exit }
-      m = s / n; var = ss / n - m * m; if (var < 0) var = 0
-      if (col ~ /^nees_position/ || col ~ /percent/) printf "%.2f (%.2f-%.2f)", m, lo, hi
-      else if (col ~ /time/) printf "%.2f", m
-      else printf "%.4f +- %.4f (%.4f-%.4f)", m, sqrt(var * n / (n > 1 ? n - 1 : 1)), lo, hi
-    }' "$@"
-}
-
-{
-  echo "# Per-scenario results"
-  echo
-  echo "Generated by \`tools/run_scenarios.sh\` on $(date -u +%Y-%m-%d) (commit"
-  echo "$COMMIT, Release build, 2-core machine,"
-  echo "swarm replays on core 0, single-agent replays at the same time on core 1, \`taskset\`). Do not edit by hand."
-  echo
-  preset="${IMPERFECTIONS:-as in each scenario file (simulator default)}"
-  [[ -n "$IMPERFECTIONS_YAML" ]] && preset="\`imperfections: $IMPERFECTIONS_YAML\` appended to each scenario file"
-  echo "Simulator preset: $preset. Seeds: each scenario's"
-  echo "file seed plus the offsets ${SEED_OFFSETS} (held out: docs/evaluation.md, \"Tuning and"
-  echo "held-out seeds\"; the estimator gets the calibration the simulator reports as given). Per drone over the"
-  echo "seeds: APE RMSE of the position after"
-  echo "SE(3) alignment as mean +- sample std (min-max) [m], mean position NEES (expected 3) with"
-  echo "its range, in G (no alignment) and gauge-aligned (the ground truth rotated about the first"
-  echo "pose onto the estimate: the map's rotation through the LiDAR-IMU calibration error;"
-  echo "\`replay/consistency.h\`), the position drift per distance as mean (min-max) [%] (mean"
-  echo "displacement error over 10 m of path from every pose, in the world frame after the SE(3)"
-  echo "alignment; docs/evaluation.md), and the mean of the per-run median per-scan time [ms]."
-} > "$DOC"
-
-for name in "${scenarios[@]}"; do
-  scenario="$ROOT/configs/scenarios/$name.yaml"
-  base_seed="$(file_seed "$scenario")"
-  [[ -n "$base_seed" ]] || { echo "no seed in $scenario" >&2; exit 1; }
-  echo "== $name (file seed $base_seed)" >&2
-  swarm_csvs=() single_csvs=() seeds=() notes=()
-  for offset in $SEED_OFFSETS; do
-    seed=$((base_seed + offset))
-    seeds+=("$seed")
-    dir="$OUT/$name/seed$seed"
-    mkdir -p "$dir"
-    variant="$dir/$name.yaml"
-    # Sensor presets resolve against the scenario file's parent directory.
-    ln -sf "$ROOT"/configs/*.yaml "$OUT/$name/"
-    sed -E "/^scenario:/,/^[a-z]/s/seed: *[0-9]+/seed: $seed/" "$scenario" > "$variant"
-    grep -qE "seed: $seed([^0-9]|\$)" "$variant" || { echo "could not set seed in $variant" >&2; exit 1; }
-    if [[ -n "$IMPERFECTIONS_YAML" ]]; then
-      grep -q '^imperfections:' "$variant" &&
-        { echo "$scenario has its own imperfections: key; IMPERFECTIONS_YAML would repeat it" >&2; exit 1; }
-      echo "imperfections: $IMPERFECTIONS_YAML" >> "$variant"
-    fi
-    sim_args=(--scenario "$variant" --output_dir "$dir/sim")
-    [[ -n "$IMPERFECTIONS" ]] && sim_args+=(--imperfections "$IMPERFECTIONS")
-    "$SIM" "${sim_args[@]}" > "$dir/sim.log" 2>&1 || { notes+=("seed $seed: simulation failed"); continue; }
-    status=0 single_status=0
-    taskset -c 0 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/swarm" \
-      --save_maps=false > "$dir/swarm.log" 2>&1 &
-    swarm_pid=$!
-    if [[ "$SINGLE_AGENT" != 0 ]]; then
-      taskset -c 1 "$REPLAY" --manifest "$dir/sim/swarm.yaml" --output_dir "$dir/single" \
-        --single_agent --save_maps=false > "$dir/single.log" 2>&1 || single_status=$?
-    fi
-    wait "$swarm_pid" || status=$?
-    [[ $status -eq 0 ]] || notes+=("seed $seed: swarm replay exit status $status")
-    [[ $single_status -eq 0 ]] || notes+=("seed $seed: single-agent replay exit status $single_status")
-    [[ -f "$dir/swarm/metrics.csv" ]] && swarm_csvs+=("$dir/swarm/metrics.csv")
-    [[ -f "$dir/single/metrics.csv" ]] && single_csvs+=("$dir/single/metrics.csv")
-  done
-  {
-    echo
-    echo "## $name (seeds ${seeds[*]})"
-    echo
-    echo '```sh'
-    echo "# per seed S: configs/scenarios/$name.yaml with seed: S, in $OUT/$name/seedS/"
-    [[ -n "$IMPERFECTIONS_YAML" ]] && echo "# with the line 'imperfections: $IMPERFECTIONS_YAML' appended"
-    echo "build/tools/sim/swarmlio_sim --scenario $name.yaml --output_dir sim${IMPERFECTIONS:+ --imperfections $IMPERFECTIONS}"
-    echo "taskset -c 0 build/tools/replay/swarmlio_replay --manifest sim/swarm.yaml --output_dir swarm --save_maps=false"
-    [[ "$SINGLE_AGENT" != 0 ]] &&
-      echo "taskset -c 1 build/tools/replay/swarmlio_replay --manifest sim/swarm.yaml --output_dir single --single_agent --save_maps=false"
-    echo '```'
-    echo
-    if [[ ${#notes[@]} -gt 0 ]]; then printf -- '- %s\n' "${notes[@]}"; fi
-    if [[ ${#swarm_csvs[@]} -eq 0 ]]; then echo "(no results)"; continue; fi
-    echo "| drone | APE swarm [m] | APE single-agent [m] | drift swarm / single [%] | NEES in G swarm | NEES in G single | NEES gauge-aligned swarm | NEES gauge-aligned single | time swarm / single [ms] |"
-    echo "|---|---|---|---|---|---|---|---|---|"
-    for drone in $(awk -F, 'NR > 1 { print $1 }' "${swarm_csvs[0]}"); do
-      printf '| %s | %s | %s | %s / %s | %s | %s | %s | %s | %s / %s |\n' "$drone" \
-        "$(stats ape_rmse_m "$drone" "${swarm_csvs[@]}")" \
-        "$(stats ape_rmse_m "$drone" "${single_csvs[@]}")" \
-        "$(stats drift_percent "$drone" "${swarm_csvs[@]}")" \
-        "$(stats drift_percent "$drone" "${single_csvs[@]}")" \
-        "$(stats nees_position "$drone" "${swarm_csvs[@]}")" \
-        "$(stats nees_position "$drone" "${single_csvs[@]}")" \
-        "$(stats nees_position_aligned "$drone" "${swarm_csvs[@]}")" \
-        "$(stats nees_position_aligned "$drone" "${single_csvs[@]}")" \
-        "$(stats time_median_ms "$drone" "${swarm_csvs[@]}")" \
-        "$(stats time_median_ms "$drone" "${single_csvs[@]}")"
-    done
-    echo
-    echo "Teammates (swarm mode), per seed: pairs identified of all ordered pairs and wrong ones, the"
-    echo "latest identification after the excitation start, the worst extrinsic error at the end and"
-    echo "after identification (max), the worst teammate relative-position RMSE, and the scans with the"
-    echo "teammate in view (>= 10 returns, simulator truth) that fused an active observation, all pairs"
-    echo "together (the worst pair):"
-    echo
-    echo "| seed | identified (wrong) | latest [s] | worst extrinsic end [m / deg] | worst extrinsic max [m / deg] | worst rel. RMSE [m] | fused in view [%] |"
-    echo "|---|---|---|---|---|---|---|"
-    for seed in "${seeds[@]}"; do
-      csv="$OUT/$name/seed$seed/swarm/swarm_pairs.csv"
-      [[ -f "$csv" ]] || { echo "| $seed | n/a | | | | | |"; continue; }
-      awk -F, -f "$ROOT/tools/pairs_summary.awk" "$csv" | awk -v seed="$seed" '{
-        printf "| %s | %d / %d (%d) | %.1f | %.3f / %.2f | %.3f / %.2f | %.3f | ", seed, $1, $2,
-               $3, $4, $5, $6, $7, $8, $9
-        if ($10 >= 0) printf "%.0f (%.0f) |\n", 100 * $10, 100 * $11; else printf "n/a |\n"
-      }'
-    done
-  } >> "$DOC"
-done
-echo "wrote $DOC" >&2
-if [[ "$HEADLINE" != 0 ]]; then
-  # The headline table replaces the block between the markers in RESULTS_DOC.
-  table="$("$ROOT/tools/results_headline.sh" "$OUT" "${scenarios[@]}")"
-  block="$(printf '%s\n\n%s\n\n%s\n' \
-    "Generated by \`tools/run_scenarios.sh ${*:-}\` (seed offsets ${SEED_OFFSETS}) on $(date -u +%Y-%m-%d), commit $COMMIT; per-seed tables: [results_scenarios.md](results_scenarios.md)." \
-    "$table" \
-    "Simulator preset: ${IMPERFECTIONS:-${IMPERFECTIONS_YAML:-as in each scenario file (realistic by default)}}.")"
-  awk -v block="$block" '
-    /<!-- headline:begin -->/ { print; print block; skip = 1; next }
-    /<!-- headline:end -->/ { skip = 0 }
-    !skip' "$RESULTS_DOC" > "$RESULTS_DOC.tmp" && mv "$RESULTS_DOC.tmp" "$RESULTS_DOC"
-  grep -q '<!-- headline:begin -->' "$RESULTS_DOC" ||
-    echo "note: no <!-- headline:begin --> marker in $RESULTS_DOC; headline not written" >&2
-fi
+exec bash "$ROOT/tools/sweep.sh" local "$ROOT/configs/sweeps/scenarios.yaml" \
+  "${OUT:-$ROOT/results/sweeps/scenarios}"

@@ -94,6 +94,42 @@ Status PlotErrorOverTime(const std::vector<ErrorSeries>& drones,
   return internal::RenderChartPng(spec, png_path);
 }
 
+Status PlotIntervals(const std::vector<IntervalSeries>& series,
+                     const std::string& x_label,
+                     const std::string& value_label,
+                     const PlotOptions& options,
+                     const std::string& png_path) {
+  if (series.size() > kMaxDrones) return TooMany(series.size());
+  internal::ChartSpec spec = BaseSpec(options, value_label + ": mean and interval");
+  spec.x_label = x_label;
+  spec.y_label = value_label;
+  spec.y_from_zero = true;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double step = 0.6 / static_cast<double>(std::max<size_t>(series.size(), 1));
+  for (size_t k = 0; k < series.size(); ++k) {
+    const IntervalSeries& s = series[k];
+    if (s.lo.size() != s.mean.size() || s.hi.size() != s.mean.size()) {
+      return Status::InvalidArgument("plot: series " + s.name + ": mean, lo, hi differ in length");
+    }
+    const double offset = (static_cast<double>(k) - 0.5 * (series.size() - 1.0)) * step;
+    internal::ChartLine means, bars;
+    means.label = s.name;
+    means.color = bars.color = internal::PaletteColor(k);
+    bars.width_px = 3.0;
+    for (size_t i = 0; i < s.mean.size(); ++i) {
+      const double x = static_cast<double>(i) + offset;
+      means.x.push_back(x);
+      means.y.push_back(s.mean[i]);
+      if (!std::isfinite(s.mean[i])) continue;
+      bars.x.insert(bars.x.end(), {x, x, nan});
+      bars.y.insert(bars.y.end(), {s.lo[i], s.hi[i], nan});
+    }
+    spec.lines.push_back(std::move(means));
+    if (!bars.x.empty()) spec.lines.push_back(std::move(bars));
+  }
+  return internal::RenderChartPng(spec, png_path);
+}
+
 TopViewSeries TopViewSeriesFromApe(const std::string& name, const ApeResult& ape) {
   TopViewSeries series;
   series.name = name;

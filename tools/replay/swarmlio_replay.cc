@@ -61,6 +61,13 @@ DEFINE_string(window_reassociate, "",
               "all | newest: re-associate every scan of the window at each iteration, or only "
               "the newest (default: each drone's "
               "odometry.window.experimental.reassociate_all_scans)");
+DEFINE_string(drone_overrides, "",
+              "YAML file whose odometry:, imu:, lidar:, teammate: and swarm: sections apply over "
+              "every drone's options from the manifest (a sweep variant, docs/sweeps.md); the "
+              "odometry defaults that follow the LiDAR are not re-derived. The back-end flags "
+              "above apply after it");
+DEFINE_int64(network_seed, -1,
+             "seed of the simulated network (over --network_config's); -1: the config's");
 DEFINE_string(received_packets, "",
               "offline re-run of live drones (docs/online.md): name=<name>_received.bin,... "
               "those drones receive exactly the recorded datagrams at their recorded arrival "
@@ -126,6 +133,21 @@ Status ApplyReceivedPacketFlags(replay::ReplayOptions* options) {
         "--received_packets needs --key_file (the live swarm's key authenticates the datagrams)");
   }
   return Status::Ok();
+}
+
+// --drone_overrides: the file's sections over every drone's options.
+Status ApplyDroneOverrides(driver::SwarmManifest* manifest) {
+  if (FLAGS_drone_overrides.empty()) return Status::Ok();
+  config::ConfigFile file;
+  SWARMLIO_RETURN_IF_ERROR(config::ConfigFile::Load(FLAGS_drone_overrides, &file));
+  for (driver::DroneInput& d : manifest->drones) {
+    SWARMLIO_RETURN_IF_ERROR(file.Read("odometry", &d.odometry));
+    SWARMLIO_RETURN_IF_ERROR(file.Read("imu", &d.imu));
+    SWARMLIO_RETURN_IF_ERROR(file.Read("lidar", &d.lidar));
+    SWARMLIO_RETURN_IF_ERROR(file.Read("teammate", &d.teammate));
+    SWARMLIO_RETURN_IF_ERROR(file.Read("swarm", &d.swarm));
+  }
+  return file.CheckNoUnusedSections();
 }
 
 // The back-end flags, applied to every drone's odometry options.
@@ -303,7 +325,8 @@ int Main() {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());
     return 1;
   }
-  status = ApplyEstimatorFlags(&manifest);
+  status = ApplyDroneOverrides(&manifest);
+  if (status.ok()) status = ApplyEstimatorFlags(&manifest);
   if (!status.ok()) {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());
     return 1;
@@ -334,6 +357,7 @@ int Main() {
       return 1;
     }
   }
+  if (FLAGS_network_seed >= 0) options.network.seed = FLAGS_network_seed;
   status = ApplyReceivedPacketFlags(&options);
   if (!status.ok()) {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());

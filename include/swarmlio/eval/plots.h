@@ -50,6 +50,27 @@ Status PlotErrorOverTime(const std::vector<ErrorSeries>& drones,
                          const PlotOptions& options,
                          const std::string& png_path);
 
+/// One series of a figure of means with intervals (e.g. one variant of a
+/// sweep): for each category index i (the x axis, 0, 1, ...) a mean and an
+/// interval [lo, hi]; a non-finite mean leaves the category out.
+struct IntervalSeries {
+  std::string name;
+  std::vector<double> mean;
+  std::vector<double> lo;
+  std::vector<double> hi;
+};
+
+/// Means joined by a line per series with a vertical bar for each interval,
+/// the series side by side within a category; y axis from 0, labelled
+/// value_label; x_label names the categories (e.g. "run 0: indoor_3uav/uav1,
+/// ..."). Errors: lengths differ, no finite mean, more than 64 series, bad
+/// size, the file cannot be written.
+Status PlotIntervals(const std::vector<IntervalSeries>& series,
+                     const std::string& x_label,
+                     const std::string& value_label,
+                     const PlotOptions& options,
+                     const std::string& png_path);
+
 /// The aligned estimate and the associated reference positions of an APE.
 TopViewSeries TopViewSeriesFromApe(const std::string& name, const ApeResult& ape);
 
