@@ -1,20 +1,20 @@
-// Broadcaster: what leaves after each scan: the own state, the own airframe
-// when due, and within the byte budget (broadcast_budget.h) the echoes for
-// the teammates' clock sync, the observations of teammates, the repeats of
+// Broadcaster: what leaves after each scan: the own state, and within the
+// byte budget (broadcast_budget.h) the echoes for the teammates' clock sync,
+// the own airframe when due, the observations of teammates, the repeats of
 // the previous scan's observations, and the own T_Gi_Gj estimates with
 // gravity.
 // docs/swarm.md "Broadcast budget", docs/network.md section 2.2.
 //
 // Priorities, highest first (what a crowded drone keeps):
-//   1. the state (always), and the own airframe with the first scan's
-//      messages and then every airframe_period_s (always when due: 78 B
-//      every 2 s by default, and without it teammates whose gates are
-//      stricter than this body may not detect it);
+//   1. the state (always);
 //   2. echoes for teammates whose clock offset is not converged yet (without
 //      them no teammate can use this drone's states; 7 B each), at most
 //      urgent_echoes_per_state;
 //   3. T_Gi_Gj entries never sent (a new identification: teammates need it
 //      for mutual and graph identification; once per teammate and session);
+//   3b. the own airframe, with the first scan's messages and then every
+//      airframe_period_s (78 B every 2 s by default; without it teammates
+//      whose gates are stricter than this body may not detect it);
 //   4. observations of teammates whose last state reports a degenerate scan
 //      (their only information along the degenerate direction);
 //   5. repeats of the previous scan's observations (for receivers that lost
@@ -26,9 +26,10 @@
 //   8. the other echoes (settled offsets only track the drift);
 //   9. the periodic re-broadcast of T_Gi_Gj entries already sent, the least
 //      recently sent first: the receivers have an older version.
-// A new T_Gi_Gj entry that does not fit holds everything below it back, so the
-// credit saves up for it (otherwise the small items below would take each
-// scan's few bytes and a 118 B broadcast would never fit). Below it, what does
+// A new T_Gi_Gj entry or a due airframe that does not fit holds everything
+// below it back, so the credit saves up for it (otherwise the small items
+// below would take each scan's few bytes and a 118 B broadcast would never
+// fit). Below them, what does
 // not fit is skipped and the smaller items after it take what is left. An
 // item that does not fit waits: a later scan, with more credit or fewer
 // teammates in view, sends it.
@@ -118,9 +119,8 @@ struct Broadcaster::Pass {
 void Broadcaster::Broadcast(const BroadcastScan& scan) {
   budget_.Refill(scan.t_k);
   Pass pass(scan);
-  // 1. The state, and the own airframe when due.
+  // 1. The state.
   MakeState(&pass);
-  AnnounceAirframe(scan.t_k);
   // 2. Echoes for teammates whose clock offset is not converged: teammates'
   // states back to them (the send delay is set when the packet leaves,
   // MessageChannel::Send).
@@ -128,6 +128,8 @@ void Broadcaster::Broadcast(const BroadcastScan& scan) {
             options_.broadcast_budget.urgent_echoes_per_state, &pass);
   // 3. T_Gi_Gj entries never sent, or overdue.
   ChooseNewExtrinsics(&pass);
+  // 3b. The own airframe, when due.
+  AnnounceAirframe(&pass);
   // 4. Observations of teammates that report degenerate scans (they depend
   // on them), then 5. the repeats, then 7. the others; each group the least
   // recently reported teammate first.
@@ -173,15 +175,20 @@ void Broadcaster::MakeState(Pass* pass) {
   if (pass->send_state) budget_.Spend(pass->state_bytes);
 }
 
-void Broadcaster::AnnounceAirframe(int64_t t_k) {
+void Broadcaster::AnnounceAirframe(Pass* pass) {
   // With the first scan's messages, then every airframe_period_s of the own
-  // clock; paid whatever the credit, like the state.
+  // clock. One that does not fit holds everything below back, like a new
+  // T_Gi_Gj entry: the credit saves up for it.
+  const int64_t t_k = pass->scan.t_k;
   const double period = options_.airframe_period_s;
   const bool due =
       period > 0.0 && (!airframe_announced_ || ToSeconds(t_k - last_airframe_ns_) >= period);
-  if (!due) return;
+  if (!due || pass->blocked) return;
   const size_t bytes = budget_.WireBytes(net::AirframePacketBytes());
-  budget_.Spend(bytes);
+  if (!budget_.TrySpend(bytes)) {
+    pass->blocked = true;
+    return;
+  }
   counters_->sent_airframe_bytes += static_cast<int64_t>(bytes);
   messages_.push_back(ToAirframeMessage(self_id_, t_k, airframe_));
   last_airframe_ns_ = t_k;

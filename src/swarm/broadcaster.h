@@ -70,7 +70,7 @@ class Broadcaster {
   struct Pass;
   // The steps of Broadcast, in priority order (broadcaster.cc's header).
   void MakeState(Pass* pass);
-  void AnnounceAirframe(int64_t t_k);
+  void AnnounceAirframe(Pass* pass);
   void AddEchoes(net::ClockSync::EchoSelection selection, int most, Pass* pass);
   void ChooseNewExtrinsics(Pass* pass);
   void SortObservations(Pass* pass);

@@ -145,7 +145,7 @@ struct SwarmOptions {
   /// This drone's airframe (DroneEstimatorOptions::airframe) is announced to
   /// the teammates with the first scan's messages and then this often, on
   /// the own clock (0 = never: teammates detect it with their own defaults).
-  /// 50 B per packet, paid from the byte budget like the state [s].
+  /// 78 B on the wire each, within the byte budget (broadcast_budget.h) [s].
   double airframe_period_s = 2.0;
   /// The bytes this drone puts on the wire: a budget shared by the optional
   /// content of its messages (docs/swarm.md "Broadcast budget").
