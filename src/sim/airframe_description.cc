@@ -12,7 +12,10 @@ constexpr double kRaySpacingM = 0.004;
 constexpr double kSparseReturnsPerScan = 4.0;
 
 // The nearest hit of `ray` on `parts` beyond t_min; false if none.
-bool NearestHit(const std::vector<Primitive>& parts, const Ray& ray, double t_min, double* t,
+bool NearestHit(const std::vector<Primitive>& parts,
+                const Ray& ray,
+                double t_min,
+                double* t,
                 const Primitive** hit) {
   *t = std::numeric_limits<double>::infinity();
   *hit = nullptr;
@@ -61,8 +64,11 @@ bool IsSparse(const std::vector<Primitive>& parts) {
 
 }  // namespace
 
-bool RayCastReflectiveCentroid(const std::vector<Primitive>& parts_b, const Eigen::Vector3d& u_in_b,
-                               double spacing_m, Eigen::Vector3d* centroid_in_b, double* spread_m) {
+bool RayCastReflectiveCentroid(const std::vector<Primitive>& parts_b,
+                               const Eigen::Vector3d& u_in_b,
+                               double spacing_m,
+                               Eigen::Vector3d* centroid_in_b,
+                               double* spread_m) {
   const Aabb box = BoundsOf(parts_b);
   const Eigen::Vector3d centre = 0.5 * (box.min + box.max);
   const double radius = 0.5 * (box.max - box.min).norm();

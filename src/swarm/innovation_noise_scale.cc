@@ -5,9 +5,13 @@
 
 namespace swarmlio::swarm::internal {
 
-double ActiveObservationNis(const ActiveObservationFactor& factor, const SwarmState& x,
-                            const Eigen::MatrixXd& P, int id, const Eigen::Vector3d& e,
-                            const Eigen::Matrix3d& factor_R, const Eigen::Matrix3d& true_R) {
+double ActiveObservationNis(const ActiveObservationFactor& factor,
+                            const SwarmState& x,
+                            const Eigen::MatrixXd& P,
+                            int id,
+                            const Eigen::Vector3d& e,
+                            const Eigen::Matrix3d& factor_R,
+                            const Eigen::Matrix3d& true_R) {
   constexpr int kE = EgoState::kTangentSize;
   constexpr int kT = GlobalExtrinsic::kTangentSize;
   Eigen::Matrix<double, 3, kE> J_ego;
@@ -24,8 +28,7 @@ double ActiveObservationNis(const ActiveObservationFactor& factor, const SwarmSt
   P_sub.topRightCorner<kE, kT>() = P.block(0, b.offset, kE, kT);
   P_sub.bottomLeftCorner<kT, kE>() = P.block(b.offset, 0, kT, kE);
   P_sub.bottomRightCorner<kT, kT>() = P.block(b.offset, b.offset, kT, kT);
-  const Eigen::Matrix3d S =
-      J * P_sub * J.transpose() + factor.covariance() - factor_R + true_R;
+  const Eigen::Matrix3d S = J * P_sub * J.transpose() + factor.covariance() - factor_R + true_R;
   return e.dot(S.ldlt().solve(e));
 }
 

@@ -25,9 +25,13 @@ namespace swarmlio::swarm::internal {
 /// `factor_R` for the observation part, `true_R` the part that is the
 /// observation's own noise; they differ by the information share) for
 /// teammate `id`, with the prediction covariance `P` of `x`.
-double ActiveObservationNis(const ActiveObservationFactor& factor, const SwarmState& x,
-                            const Eigen::MatrixXd& P, int id, const Eigen::Vector3d& e,
-                            const Eigen::Matrix3d& factor_R, const Eigen::Matrix3d& true_R);
+double ActiveObservationNis(const ActiveObservationFactor& factor,
+                            const SwarmState& x,
+                            const Eigen::MatrixXd& P,
+                            int id,
+                            const Eigen::Vector3d& e,
+                            const Eigen::Matrix3d& factor_R,
+                            const Eigen::Matrix3d& true_R);
 
 /// The scale after one more observation with `nis` (the file comment).
 double UpdatedNoiseScale(double scale, double nis, const SwarmOptions& options);

@@ -31,10 +31,9 @@ double WorstModelError(const DroneBodyOptions& body, bool flip) {
       const Eigen::Vector3d u = View(azimuth, elevation);
       Eigen::Vector3d cast;
       EXPECT_TRUE(RayCastReflectiveCentroid(parts, u, kSpacingM, &cast));
-      const Eigen::Vector3d model = a.reflector_centre_in_body_m +
-                                    teammate::VisibleReflectorCentroid(a, flip ? -u : u);
+      const Eigen::Vector3d model =
+          a.reflector_centre_in_body_m + teammate::VisibleReflectorCentroid(a, flip ? -u : u);
       worst = std::max(worst, (model - cast).norm());
-
     }
   }
   return worst;

@@ -44,8 +44,8 @@ TEST(Airframe, BoxCentroidLiesTowardsTheObserverOnEveryFace) {
   // their centres weighted by their areas b c and a c.
   const Eigen::Vector3d u = Eigen::Vector3d(1, 1, 0).normalized();
   const double a = 0.2, b = 0.1;
-  EXPECT_TRUE(VisibleReflectorCentroid(box, u).isApprox(
-      Eigen::Vector3d(a * b, b * a, 0) / (b + a), 1e-12));
+  EXPECT_TRUE(
+      VisibleReflectorCentroid(box, u).isApprox(Eigen::Vector3d(a * b, b * a, 0) / (b + a), 1e-12));
   for (double azimuth = 0.1; azimuth < 2 * M_PI; azimuth += 0.5) {
     const Eigen::Vector3d v(std::cos(azimuth), std::sin(azimuth), -0.3);
     EXPECT_GT(VisibleReflectorCentroid(box, v.normalized()).dot(v), 0.0);
@@ -78,8 +78,8 @@ TEST(Airframe, ObservationPlacesTheBodyOriginBehindTheAnnouncedReflector) {
   cluster.reflective_centroid_in_b = p_bj_in_bi + R_bi_bj * face_in_bj;
   cluster.centroid_in_b = cluster.reflective_centroid_in_b;
   ObservationOptions options;
-  const TeammateObservation with = MakeObservation(1, 0, cluster, Eigen::Vector3d::Zero(), options,
-                                                   &R_bi_bj, &band);
+  const TeammateObservation with =
+      MakeObservation(1, 0, cluster, Eigen::Vector3d::Zero(), options, &R_bi_bj, &band);
   // The view direction is the returns' centroid's, not the body origin's:
   // 0.35 mm here.
   EXPECT_LT((with.p_bj_in_bi - p_bj_in_bi).norm(), 0.001);

@@ -22,8 +22,10 @@ namespace swarmlio::sim {
 /// probability p < 1) with weight p and lets 1 - p through, a diffuse part
 /// stops it. `spread_m` (optional): the weighted RMS distance of the returns
 /// from that centroid. False when no ray returns.
-bool RayCastReflectiveCentroid(const std::vector<Primitive>& parts_b, const Eigen::Vector3d& u_in_b,
-                               double spacing_m, Eigen::Vector3d* centroid_in_b,
+bool RayCastReflectiveCentroid(const std::vector<Primitive>& parts_b,
+                               const Eigen::Vector3d& u_in_b,
+                               double spacing_m,
+                               Eigen::Vector3d* centroid_in_b,
                                double* spread_m = nullptr);
 
 /// The airframe description of a simulated body (the header comment).

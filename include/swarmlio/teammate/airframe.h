@@ -52,7 +52,7 @@ namespace swarmlio::teammate {
 struct AirframeDescription {
   ReflectorShape reflector_shape = ReflectorShape::kBand;
   Eigen::Vector3d reflector_half_extents_m = Eigen::Vector3d(0.102, 0.072, 0.025);  // a, b, c [m]
-  Eigen::Vector3d reflector_centre_in_body_m = Eigen::Vector3d::Zero();  // [m]
+  Eigen::Vector3d reflector_centre_in_body_m = Eigen::Vector3d::Zero();             // [m]
   double depth_offset_m = 0.07;   // round: returns' centroid in front of the centre [m]
   double size_m = 0.45;           // bounding-box diagonal of the whole airframe [m]
   double min_intensity = 151.0;   // lowest intensity its reflectors return (Livox 0-255)
@@ -70,11 +70,13 @@ struct AirframeDescription {
       FieldSpec::InRange(-2.0, 2.0, "m", "centre of the reflective parts in the body (IMU) frame"));
     v("depth_offset_m", depth_offset_m,
       FieldSpec::InRange(0.0, 1.0, "m", "round: the returns' centroid lies this far in front"));
-    v("size_m", size_m, FieldSpec::InRange(0.05, 5.0, "m", "bounding-box diagonal of the airframe"));
+    v("size_m", size_m,
+      FieldSpec::InRange(0.05, 5.0, "m", "bounding-box diagonal of the airframe"));
     v("min_intensity", min_intensity,
       FieldSpec::InRange(0.0, 255.0, "", "lowest intensity of the reflective parts (Livox 0-255)"));
     v("centroid_sigma_m", centroid_sigma_m,
-      FieldSpec::InRange(0.0, 1.0, "m", "per-scan scatter of the returns' centroid (sparse reflectors)"));
+      FieldSpec::InRange(0.0, 1.0, "m",
+                         "per-scan scatter of the returns' centroid (sparse reflectors)"));
   }
   std::string Validate() const { return config::ValidateFields(*this); }
 };
