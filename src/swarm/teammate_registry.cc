@@ -31,6 +31,11 @@ void ApplySigmaFloors(const SwarmOptions& so, Eigen::Matrix<double, 6, 6>* C) {
   }
 }
 
+// k's derived block came through teammate j (j is in its chain).
+bool ChainEndsAt(const TeammateInfo& info_k, int j) {
+  return info_k.derived_through.count(j) > 0;
+}
+
 }  // namespace
 
 void TeammateRegistry::UpdateBlocks(int64_t t_k, const teammate::ScanResult& detection,
@@ -64,6 +69,23 @@ void TeammateRegistry::AddBlock(int id, int64_t t_k, const GlobalExtrinsic& T,
   teammates_[id].last_seen_ns = t_k;
 }
 
+bool TeammateRegistry::FollowsSource(int id) const {
+  const auto it = teammates_.find(id);
+  return it != teammates_.end() && it->second.second_hand &&
+         it->second.observations_fused < options_.follow_source_until_observations;
+}
+
+void TeammateRegistry::ReplaceBlock(int id, const GlobalExtrinsic& T,
+                                    const Eigen::Matrix<double, 6, 6>& C,
+                                    const Eigen::MatrixXd& cross, SwarmState* x,
+                                    Eigen::MatrixXd* P) {
+  x->teammate(id) = T;
+  const Segment b = x->layout().TeammateBlock(id);
+  P->middleRows(b.offset, 6) = cross;
+  P->middleCols(b.offset, 6) = cross.transpose();
+  P->block<6, 6>(b.offset, b.offset) = C;
+}
+
 void TeammateRegistry::AddMatched(int64_t t_k, const teammate::ScanResult& detection,
                                   SwarmState* x, Eigen::MatrixXd* P, ScanReport* report) {
   const SwarmOptions& so = options_;
@@ -82,6 +104,7 @@ void TeammateRegistry::AddMatched(int64_t t_k, const teammate::ScanResult& detec
     C.diagonal().tail<3>().setConstant(sigma_p * sigma_p);
     AddBlock(id.drone_id, t_k, T_Gi_Gj, C, x, P);
     SetProvenance(false, {}, &teammates_[id.drone_id]);
+    teammates_[id.drone_id].second_hand = false;
     IdentificationEvent event = Event(id.drone_id, t_k, "trajectory_match", T_Gi_Gj);
     event.mean_residual_m = id.mean_residual_m;
     report->identifications.push_back(event);
@@ -91,16 +114,24 @@ void TeammateRegistry::AddMatched(int64_t t_k, const teammate::ScanResult& detec
 void TeammateRegistry::AddMutual(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P,
                                  ScanReport* report) {
   for (const auto& [j, pending] : mutual_) {
-    if (x->HasTeammate(j) || teammates_[j].restarted) continue;
+    if (teammates_[j].restarted) continue;
+    const bool follow = x->HasTeammate(j) && !teammates_[j].via_graph && FollowsSource(j);
+    if (x->HasTeammate(j) && !follow) continue;
     GlobalExtrinsic T_Gi_Gj;
     Eigen::Matrix<double, 6, 6> C;
     InvertExtrinsic(pending.T_Gj_Gi, pending.cov_T_Gj_Gi, &T_Gi_Gj, &C);
-    if (!detector_->AddIdentifiedTeammate(j, t_k, T_Gi_Gj.R_Ga_Gb(), T_Gi_Gj.p_Gb_in_Ga)) continue;
     // Positive definite whatever arrived, and at least the covariance of an
     // own match with zero residual.
     C = Regularized<6>(C, 1e-10);
     ApplySigmaFloors(options_, &C);
+    if (follow) {
+      // j's newer estimate of the same edge, independent of this drone's state.
+      ReplaceBlock(j, T_Gi_Gj, C, Eigen::MatrixXd::Zero(6, P->rows()), x, P);
+      continue;
+    }
+    if (!detector_->AddIdentifiedTeammate(j, t_k, T_Gi_Gj.R_Ga_Gb(), T_Gi_Gj.p_Gb_in_Ga)) continue;
     AddBlock(j, t_k, T_Gi_Gj, C, x, P);
+    teammates_[j].second_hand = true;
     // The inverse of an edge j derived itself stays derived, through
     // teammates j did not name: any teammate heard so far may be in its chain.
     const bool derived = pending.source == net::ExtrinsicSource::kGraph;
@@ -127,7 +158,13 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
     const Segment bj = x->layout().TeammateBlock(j);
     const Eigen::Matrix<double, 6, 6> P_ij = P->block<6, 6>(bj.offset, bj.offset);
     for (const auto& [k, match] : info_j.identified) {
-      if (k == self_id_ || x->HasTeammate(k)) continue;
+      if (k == self_id_ || k == j) continue;
+      // A block k already holds follows a new composition while it has
+      // little of its own, and only through the teammate it came through.
+      if (x->HasTeammate(k) &&
+          !(teammates_[k].via_graph && FollowsSource(k) && ChainEndsAt(teammates_[k], j))) {
+        continue;
+      }
       if (ChainPassesThrough(info_j, k, teammates_)) continue;
       const auto it_k = teammates_.find(k);
       if (it_k != teammates_.end() && it_k->second.restarted) continue;
@@ -142,17 +179,24 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
     }
   }
   for (const auto& [k, c] : best) {
+    // Cross-covariances: d(T_ik) = J_ij d(T_ij) + J_jk d(T_jk) with d(T_jk)
+    // independent of this drone's state, so P(k, :) = J_ij P(j, :).
+    const Segment bj = x->layout().TeammateBlock(c.via);
+    Eigen::MatrixXd cross = c.J_ij * P->middleRows(bj.offset, 6);
+    Eigen::Matrix<double, 6, 6> C = 0.5 * (c.C + c.C.transpose());
+    ApplySigmaFloors(options_, &C);
+    if (x->HasTeammate(k)) {
+      const Segment bk = x->layout().TeammateBlock(k);
+      cross.middleCols(bk.offset, 6).setZero();  // its own block: C
+      ReplaceBlock(k, c.T_Gi_Gk, C, cross, x, P);
+      continue;
+    }
     if (!detector_->AddIdentifiedTeammate(k, t_k, c.T_Gi_Gk.R_Ga_Gb(), c.T_Gi_Gk.p_Gb_in_Ga)) {
       continue;
     }
-    // Cross-covariances: d(T_ik) = J_ij d(T_ij) + J_jk d(T_jk) with d(T_jk)
-    // independent of this drone's state, so P(k, :) = J_ij P(j, :).
     const int n = static_cast<int>(P->rows());
-    const Segment bj = x->layout().TeammateBlock(c.via);
-    const Eigen::MatrixXd cross = c.J_ij * P->middleRows(bj.offset, 6);
-    Eigen::Matrix<double, 6, 6> C = 0.5 * (c.C + c.C.transpose());
-    ApplySigmaFloors(options_, &C);
     AddBlock(k, t_k, c.T_Gi_Gk, C, x, P);
+    teammates_[k].second_hand = true;
     P->block(n, 0, 6, n) = cross;
     P->block(0, n, n, 6) = cross.transpose();
     // k's chain: j's (empty when j is first-hand) and j itself.

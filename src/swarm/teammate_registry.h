@@ -55,6 +55,13 @@ class TeammateRegistry {
   // first-hand teammate j identified and this drone has not.
   void AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P, ScanReport* report);
   void RemoveLost(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P, ScanReport* report);
+  // A second-hand block that has not fused enough own observations
+  // (follow_source_until_observations) takes its source's newer estimate.
+  bool FollowsSource(int id) const;
+  // Replaces the block of `id` by T with covariance C and cross-covariances
+  // `cross` (6 x n, the other rows of P; zero when independent).
+  void ReplaceBlock(int id, const GlobalExtrinsic& T, const Eigen::Matrix<double, 6, 6>& C,
+                    const Eigen::MatrixXd& cross, SwarmState* x, Eigen::MatrixXd* P);
   // The block of `id` enters the state at t_k with covariance C.
   void AddBlock(int id, int64_t t_k, const GlobalExtrinsic& T, const Eigen::Matrix<double, 6, 6>& C,
                 SwarmState* x, Eigen::MatrixXd* P);

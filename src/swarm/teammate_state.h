@@ -40,6 +40,7 @@ struct TeammateInfo {
   // made before this + max_message_age_s are of its old G_j.
   int64_t session_heard_ns = 0;
   bool via_graph = false;          // its block came through a teammate's T_Gj_Gk
+  bool second_hand = false;        // its block came from a teammate (mutual or graph)
   // Provenance of a derived block (via_graph): the teammates whose frames its
   // chain T_Gi_Gv ... T_Gw_Gj may pass through, each with the session it was
   // in then (id -> session_start_ns). Empty for a first-hand block.

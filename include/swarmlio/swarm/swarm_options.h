@@ -139,6 +139,11 @@ struct SwarmOptions {
   /// into its block before it may serve as an intermediary while the
   /// teammates it came through are still in the state [count].
   int graph_derived_min_observations = 20;
+  /// A teammate's block that came from a teammate (its T_Gj_Gi inverted, or
+  /// composed through the graph) follows that source's newer estimates until
+  /// this many own observations were fused into it (docs/swarm.md "Second-hand
+  /// blocks follow their source"); 0 = never (the block keeps its first value).
+  int follow_source_until_observations = 20;
   /// The own T_Gi_Gj estimates are broadcast this often (0 = never) [s];
   /// new ones at once. Entries per broadcast: broadcast_budget.
   double extrinsic_broadcast_period_s = 1.0;
@@ -218,6 +223,10 @@ struct SwarmOptions {
       x("graph_derived_min_observations", graph_derived_min_observations,
         FieldSpec::AtLeast(
             0, "", "own observations fused into a graph-derived block before it may relay"));
+      x("follow_source_until_observations", follow_source_until_observations,
+        FieldSpec::AtLeast(0, "",
+                           "a second-hand block follows its source's newer estimates until this "
+                           "many own observations were fused (0 = never)"));
       x("airframe_period_s", airframe_period_s,
         FieldSpec::InRange(0.0, 3600.0, "s", "announce the own airframe this often (0 = never)"));
     });
