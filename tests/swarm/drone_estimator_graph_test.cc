@@ -134,5 +134,43 @@ TEST(DroneEstimator, ReidentifiesARestartedTeammateThroughTheInverseOfADerivedEn
   EXPECT_LT(r.error_deg, 1.2);
 }
 
+// A teammate identified the observer with a wrong first match (40 deg of
+// yaw) and corrected it a second later (docs/swarm.md "Second-hand blocks
+// follow their source"): the observer adopted the inverse of the first value
+// and, looking for the teammate where that puts it, gets no observation of
+// its own. The block follows the teammate's newer estimates; with
+// follow_source_until_observations 0 (the old rule) it keeps the wrong one.
+double MutualErrorAtTheEndDeg(int follow_until) {
+  sim::Scenario scenario = IndoorScenario();
+  const int observer = 0, teammate = 1;
+  ObserverRun run(std::move(scenario), 13.0, observer, teammate,
+                  [follow_until](DroneEstimatorOptions* o) {
+                    o->swarm.follow_source_until_observations = follow_until;
+                  });
+  ObserverSink& sink = *run.sink;
+  sink.mutual_at_s = 10.0;
+  sink.mutual_wrong_until_s = 11.0;
+  sink.mutual_wrong_yaw_deg = 40.0;
+  EXPECT_TRUE(run.Run());
+  const Eigen::Isometry3d T_true = ToIsometry(run.simulator->T_W_G(observer)).inverse() *
+                                   ToIsometry(run.simulator->T_W_G(teammate));
+  for (const TeammateEstimate& t : sink.outputs.back().teammates) {
+    if (t.drone_id != teammate) continue;
+    return Eigen::AngleAxisd(t.T_Gi_Gj.R_Ga_Gb().transpose() * T_true.linear()).angle() * 180.0 /
+           M_PI;
+  }
+  return -1.0;  // not in the state
+}
+
+TEST(DroneEstimator, AnAdoptedExtrinsicFollowsItsSourcesCorrection) {
+  const double following = MutualErrorAtTheEndDeg(20);
+  const double keeping = MutualErrorAtTheEndDeg(0);
+  std::printf("[ figures  ] adopted T_G0_G1 at the end: %.3f deg following the source, %.3f deg "
+              "keeping the first value\n", following, keeping);
+  ASSERT_GE(following, 0.0);
+  EXPECT_LT(following, 0.6);  // 0.24 deg measured
+  EXPECT_GT(keeping, 20.0);
+}
+
 }  // namespace
 }  // namespace swarmlio::swarm

@@ -152,6 +152,10 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
   std::vector<int64_t> teammate_entry_stamps;  // broadcasts with the teammate's entry
   double restart_at_s = 1e9;                   // the teammate reboots then (new session_start)
   double mutual_at_s = 1e9;    // from then on the teammate sends its T_Gj_Gi (it identified us)
+  // Until then its T_Gj_Gi is off by this yaw about G_j's origin (a wrong
+  // first match that its own observations later corrected).
+  double mutual_wrong_until_s = -1.0;
+  double mutual_wrong_yaw_deg = 0.0;
   int indefinite_every_k = 0;  // every k-th broadcast has indefinite covariances (0: none)
   int gravity_messages_delivered = 0;  // GlobalExtrinsic messages with the teammate's gravity
   int relayed_id = -1;  // with mutual_at_s: the teammate also sends its own match of this drone
@@ -254,7 +258,12 @@ class ObserverSink : public sim::DroneSink, public driver::DriverSink {
       // The teammate's new session has not identified the observer.
       if (t >= mutual_at_s && t < restart_at_s) {
         // The teammate's estimate of T_Gj_Gi: the truth, 1 cm / 0.2 deg sigma.
-        const Eigen::Isometry3d T_Gj_Gi = T_Gj_W_ * ToIsometry(sim_.T_W_G(observer_));
+        Eigen::Isometry3d T_Gj_Gi = T_Gj_W_ * ToIsometry(sim_.T_W_G(observer_));
+        if (t < mutual_wrong_until_s) {
+          T_Gj_Gi = Eigen::Isometry3d(Eigen::AngleAxisd(mutual_wrong_yaw_deg * M_PI / 180.0,
+                                                        Eigen::Vector3d::UnitZ())) *
+                    T_Gj_Gi;
+        }
         net::GlobalExtrinsicMessage g;
         g.sender_id = teammate_;
         g.stamp_ns = m.stamp_ns;
