@@ -32,15 +32,20 @@ std::string CheckCompressionFor(BagFormat format, BagCompression compression) {
   if (format == BagFormat::kMcap && compression == BagCompression::kBz2) {
     return "compression: bz2 is for ROS1 bags (MCAP files: none, lz4, zstd)";
   }
+  if (format == BagFormat::kDb3 && compression != BagCompression::kNone) {
+    return "compression: rosbag2 .db3 files are written uncompressed (none)";
+  }
   return "";
 }
 
 BagFormat ResolveBagFormat(BagFormat format, const std::string& path) {
   if (format != BagFormat::kAuto) return format;
-  const std::string extension = ".mcap";
-  const bool mcap = path.size() >= extension.size() &&
-                    path.compare(path.size() - extension.size(), extension.size(), extension) == 0;
-  return mcap ? BagFormat::kMcap : BagFormat::kRos1;
+  const auto ends_with = [&path](const std::string& extension) {
+    return path.size() >= extension.size() &&
+           path.compare(path.size() - extension.size(), extension.size(), extension) == 0;
+  };
+  if (ends_with(".mcap")) return BagFormat::kMcap;
+  return ends_with(".db3") ? BagFormat::kDb3 : BagFormat::kRos1;
 }
 
 std::string BagWriterOptions::Validate() const {

@@ -15,6 +15,7 @@
 #include "src/io/cdr_serialize.h"
 #include "src/io/custom_msg.h"
 #include "src/io/custom_msg_codec.h"
+#include "src/io/db3_writer.h"
 #include "src/io/imu_codec.h"
 #include "src/io/mcap_writer.h"
 #include "src/io/message_types.h"
@@ -76,6 +77,12 @@ class BagWriter::Impl {
     const BagFormat format = ResolveBagFormat(options_.format, path_);
     if (error.empty()) error = CheckCompressionFor(format, options_.compression);
     if (!error.empty()) return Status::InvalidArgument("BagWriterOptions: " + error);
+    if (format == BagFormat::kDb3) {
+      db3_ = std::make_unique<internal::Db3Writer>();
+      SWARMLIO_RETURN_IF_ERROR(db3_->Open(path_));
+      open_ = true;
+      return Status::Ok();
+    }
     if (format == BagFormat::kMcap) {
       internal::McapWriterOptions mcap_options;
       mcap_options.compression = McapCompression(options_.compression);
@@ -154,6 +161,7 @@ class BagWriter::Impl {
     if (!open_) return Status::Ok();
     open_ = false;
     if (mcap_ != nullptr) return mcap_->Close();
+    if (db3_ != nullptr) return db3_->Close();
     try {
       bag_.close();
     } catch (const std::exception& e) {
@@ -167,6 +175,18 @@ class BagWriter::Impl {
   const std::string& path() const { return path_; }
 
  private:
+  // rosbag2 .db3: the topic's row on first use.
+  Status Db3Topic(const std::string& topic, internal::MessageKind kind, int64_t* id) {
+    const auto found = db3_topics_.find(topic);
+    if (found != db3_topics_.end()) {
+      *id = found->second;
+      return Status::Ok();
+    }
+    SWARMLIO_RETURN_IF_ERROR(db3_->AddTopic(topic, internal::Ros2TypeName(kind), id));
+    db3_topics_[topic] = *id;
+    return Status::Ok();
+  }
+
   // MCAP: the topic's channel (and its type's schema) on first use.
   Status McapChannel(const std::string& topic, internal::MessageKind kind, uint16_t* channel) {
     const auto found = mcap_channels_.find(topic);
@@ -198,8 +218,13 @@ class BagWriter::Impl {
     }
     SWARMLIO_RETURN_IF_ERROR(CheckRos2Stamp(msg.header.stamp).WithContext("bag '" + path_ + "'"));
     uint16_t channel = 0;
-    SWARMLIO_RETURN_IF_ERROR(McapChannel(topic, kind, &channel));
     internal::SerializeCdr(msg, &buffer_);
+    if (db3_ != nullptr) {
+      int64_t topic_id = 0;
+      SWARMLIO_RETURN_IF_ERROR(Db3Topic(topic, kind, &topic_id));
+      return db3_->WriteMessage(topic_id, record_time_ns, buffer_);
+    }
+    SWARMLIO_RETURN_IF_ERROR(McapChannel(topic, kind, &channel));
     return mcap_->WriteMessage(channel, static_cast<uint64_t>(record_time_ns), buffer_);
   }
 
@@ -209,7 +234,7 @@ class BagWriter::Impl {
                int64_t record_time_ns,
                const Msg& msg) {
     if (!open_) return Status::FailedPrecondition("bag '" + path_ + "': writer is closed");
-    if (mcap_ != nullptr) return WriteMcap(topic, kind, record_time_ns, msg);
+    if (mcap_ != nullptr || db3_ != nullptr) return WriteMcap(topic, kind, record_time_ns, msg);
     ros::Time time;
     SWARMLIO_RETURN_IF_ERROR(internal::BagTimeFromStampNs(record_time_ns, &time)
                                  .WithContext("bag '" + path_ + "': record time"));
@@ -227,6 +252,8 @@ class BagWriter::Impl {
   BagWriterOptions options_;
   rosbag::Bag bag_;
   std::unique_ptr<internal::McapWriter> mcap_;  // set when writing MCAP instead of ROS1
+  std::unique_ptr<internal::Db3Writer> db3_;    // set when writing a rosbag2 .db3 file
+  std::map<std::string, int64_t> db3_topics_;
   std::map<std::string, uint16_t> mcap_channels_;
   std::map<internal::MessageKind, uint16_t> mcap_schemas_;
   std::vector<uint8_t> buffer_;

@@ -150,7 +150,14 @@ io::BagWriterOptions BagOptionsFor(const io::BagWriterOptions& base, const Lidar
 }
 
 std::string BagFileName(const std::string& name, const io::BagWriterOptions& options) {
-  return name + (options.format == io::BagFormat::kMcap ? ".mcap" : ".bag");
+  switch (options.format) {
+    case io::BagFormat::kMcap:
+      return name + ".mcap";
+    case io::BagFormat::kDb3:
+      return name + ".db3";
+    default:
+      return name + ".bag";
+  }
 }
 
 Status DroneOutputWriter::Open(const std::string& bag_path, const std::string& tum_path,

@@ -215,6 +215,10 @@ class ForeignBagTest : public ::testing::Test {
     return result;
   }
 
+  // The same flight simulated into a ROS 2 log of `format`: replayed, the
+  // trajectory equals the ROS1 bag's to 1e-9 m.
+  static void ExpectSameAsTheRos1Bag(io::BagFormat format, const std::string& extension);
+
   static fs::path* dir_;
   static SimDrone mid360_, spinning_;
   static std::vector<PoseStamped>* truth_mid360_;
@@ -306,12 +310,21 @@ TEST_F(ForeignBagTest, SpinningCloudWithoutPointTimeTracksLikeTheOriginal) {
   EXPECT_LT(reconstructed.rmse_m, instant.rmse_m);
 }
 
-// The same flight simulated into a ROS1 bag and into an MCAP file of ROS 2
-// CDR messages: replayed, the trajectories are the same to 1e-9 m.
+// The same flight simulated into a ROS1 bag and into a ROS 2 log of CDR
+// messages (an MCAP file, a rosbag2 .db3 file): replayed, the trajectories
+// are the same to 1e-9 m.
 TEST_F(ForeignBagTest, SameFlightFromMcapGivesTheSameTrajectory) {
+  ExpectSameAsTheRos1Bag(io::BagFormat::kMcap, ".mcap");
+}
+
+TEST_F(ForeignBagTest, SameFlightFromDb3GivesTheSameTrajectory) {
+  ExpectSameAsTheRos1Bag(io::BagFormat::kDb3, ".db3");
+}
+
+void ForeignBagTest::ExpectSameAsTheRos1Bag(io::BagFormat format, const std::string& extension) {
   SimDrone mcap;
-  ASSERT_TRUE(Simulate(*dir_, "mid360_ros2", false, &mcap, io::BagFormat::kMcap).ok());
-  ASSERT_EQ(fs::path(mcap.bag).extension(), ".mcap");
+  ASSERT_TRUE(Simulate(*dir_, "mid360_ros2" + extension.substr(1), false, &mcap, format).ok());
+  ASSERT_EQ(fs::path(mcap.bag).extension(), extension);
   const RunResult from_bag = Run(Input(mid360_, mid360_.bag), *truth_mid360_);
   const RunResult from_mcap = Run(Input(mcap, mcap.bag), *truth_mid360_);
   EXPECT_EQ(from_mcap.imu_topic, "/livox/imu");

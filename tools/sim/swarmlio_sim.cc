@@ -1,12 +1,13 @@
 // swarmlio_sim: runs a scenario and writes, per drone, a ROS1 bag
 // (<name>.bag: /livox/lidar, /livox/imu, /ground_truth/pose) or with
-// --bag_format=mcap an MCAP file of ROS 2 messages (<name>.mcap), a TUM ground
+// --bag_format=mcap / db3 a ROS 2 log of CDR messages (<name>.mcap, or a
+// rosbag2 SQLite file <name>.db3), a TUM ground
 // truth file in the drone's global frame (<name>_gt_tum.txt), and the resolved
 // scenario (resolved_scenario.yaml: T_W_Gi, extrinsics, noise settings) and
 // the replay manifest (swarm.yaml) for swarmlio_replay.
 //
 //   swarmlio_sim --scenario=configs/scenarios/indoor_3uav.yaml --output_dir=out
-//                [--imperfections=realistic] [--bag_format=mcap]
+//                [--imperfections=realistic] [--bag_format=mcap|db3]
 #include <gflags/gflags.h>
 
 #include <chrono>
@@ -27,8 +28,8 @@ DEFINE_string(scenario, "", "scenario YAML file (configs/scenarios/*.yaml)");
 DEFINE_string(output_dir, "", "output folder (created)");
 DEFINE_string(bag_format,
               "",
-              "override the scenario's bag.format: ros1 (<name>.bag) or mcap (<name>.mcap, ROS 2 "
-              "CDR messages)");
+              "override the scenario's bag.format: ros1 (<name>.bag), mcap (<name>.mcap) or db3 "
+              "(<name>.db3, rosbag2 SQLite), the last two of ROS 2 CDR messages");
 DEFINE_double(duration_s, 0.0, "override the scenario duration when > 0");
 DEFINE_int64(seed, -1, "override the scenario seed when >= 0");
 DEFINE_int32(threads, 0, "override the number of worker threads when > 0");

@@ -19,7 +19,7 @@ enum class BagCompression { kNone, kLz4, kBz2, kZstd };
 
 /// Container format of a written bag. kAuto: MCAP when the path ends in
 /// ".mcap", else ROS1.
-enum class BagFormat { kAuto, kRos1, kMcap };
+enum class BagFormat { kAuto, kRos1, kMcap, kDb3 };
 
 /// Topic option value (or "") that finds the topic by its message type.
 inline constexpr char kAutoTopic[] = "auto";
@@ -135,14 +135,15 @@ struct BagWriterOptions {
       config::FieldSpec::Doc("chunk compression: none, lz4 or bz2 (ROS1), none, lz4 or zstd "
                              "(MCAP)"));
     v("format", format,
-      config::FieldSpec::Doc("auto (MCAP for a .mcap path, else ROS1), ros1 or mcap (ROS 2 "
-                             "CDR messages in MCAP)"));
+      config::FieldSpec::Doc("auto (by the path: .mcap, .db3, else ROS1), ros1, mcap or db3 "
+                             "(ROS 2 CDR messages in MCAP or in a rosbag2 SQLite file)"));
   }
 
   std::string Validate() const;
 };
 
-/// `format`, or for kAuto the format of `path` (MCAP for ".mcap", else ROS1).
+/// `format`, or for kAuto the format of `path` (MCAP for ".mcap", rosbag2
+/// SQLite for ".db3", else ROS1).
 BagFormat ResolveBagFormat(BagFormat format, const std::string& path);
 
 /// "" when `compression` suits `format` (kAuto: any), else the error.
@@ -181,10 +182,11 @@ struct EnumTraits<io::BagCompression> {
 
 template <>
 struct EnumTraits<io::BagFormat> {
-  static constexpr std::array<std::pair<io::BagFormat, const char*>, 3> kNames{{
+  static constexpr std::array<std::pair<io::BagFormat, const char*>, 4> kNames{{
       {io::BagFormat::kAuto, "auto"},
       {io::BagFormat::kRos1, "ros1"},
       {io::BagFormat::kMcap, "mcap"},
+      {io::BagFormat::kDb3, "db3"},
   }};
 };
 
