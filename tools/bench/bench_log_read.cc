@@ -1,0 +1,78 @@
+// bench_log_read: the time to read whole logs through io::BagReader (open,
+// decode every IMU sample, scan and ground-truth pose in stamp order), for
+// comparing the formats of the same flight (issue: an MCAP log read at least
+// as fast as the ROS1 bag). Each set of files is read --repeats times; the
+// report is the fastest pass (the others warm the page cache).
+//
+//   bench_log_read --repeats=5 ros1/uav1.bag,ros1/uav2.bag,ros1/uav3.bag
+//                  mcap/uav1.mcap,mcap/uav2.mcap,mcap/uav3.mcap   (one line)
+#include <gflags/gflags.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "swarmlio/io/bag_reader.h"
+
+DEFINE_int32(repeats, 5, "passes over each set of files (the fastest is reported)");
+
+namespace {
+
+std::vector<std::string> Split(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+// Reads every file of `files` once; false (printed) on an error.
+bool ReadOnce(const std::vector<std::string>& files, int64_t* records) {
+  *records = 0;
+  for (const std::string& path : files) {
+    std::unique_ptr<swarmlio::io::BagReader> reader;
+    swarmlio::Status status = swarmlio::io::BagReader::Open(path, {}, &reader);
+    swarmlio::io::BagRecord record;
+    bool has_record = true;
+    while (status.ok() && has_record) {
+      status = reader->Next(&record, &has_record);
+      if (has_record) ++*records;
+    }
+    if (!status.ok()) {
+      std::fprintf(stderr, "error: %s\n", status.message().c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  gflags::SetUsageMessage("bench_log_read [--repeats=N] FILE[,FILE...] [FILE[,FILE...] ...]");
+  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (argc < 2 || FLAGS_repeats < 1) {
+    std::fprintf(stderr, "usage: %s\n", gflags::ProgramUsage());
+    return 2;
+  }
+  std::printf("| files | records | fastest pass [s] | records/s |\n|---|---|---|---|\n");
+  for (int k = 1; k < argc; ++k) {
+    const std::vector<std::string> files = Split(argv[k]);
+    double best_s = 1e300;
+    int64_t records = 0;
+    for (int pass = 0; pass < FLAGS_repeats; ++pass) {
+      const auto start = std::chrono::steady_clock::now();
+      if (!ReadOnce(files, &records)) return 1;
+      const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+      best_s = std::min(best_s, elapsed.count());
+    }
+    std::printf("| %s | %lld | %.3f | %.0f |\n", argv[k], static_cast<long long>(records), best_s,
+                static_cast<double>(records) / best_s);
+  }
+  return 0;
+}
