@@ -1,7 +1,10 @@
 #include "swarmlio/sim/airframe_description.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "swarmlio/sim/bvh.h"
 
 namespace swarmlio::sim {
 namespace {
@@ -11,31 +14,9 @@ constexpr double kRaySpacingM = 0.004;
 // the simulated shell, docs/simulator.md), for the centroid's scatter.
 constexpr double kSparseReturnsPerScan = 4.0;
 
-// The nearest hit of `ray` on `parts` beyond t_min; false if none.
-bool NearestHit(const std::vector<Primitive>& parts,
-                const Ray& ray,
-                double t_min,
-                double* t,
-                const Primitive** hit) {
-  *t = std::numeric_limits<double>::infinity();
-  *hit = nullptr;
-  for (const Primitive& p : parts) {
-    double t_p = 0.0;
-    Eigen::Vector3d normal;
-    if (p.Intersect(ray, t_min, *t, &t_p, &normal) && t_p < *t) {
-      *t = t_p;
-      *hit = &p;
-    }
-  }
-  return *hit != nullptr;
-}
-
 Aabb BoundsOf(const std::vector<Primitive>& parts) {
   Aabb box;
-  for (const Primitive& p : parts) {
-    box.min = box.min.cwiseMin(p.bounds().min);
-    box.max = box.max.cwiseMax(p.bounds().max);
-  }
+  for (const Primitive& p : parts) box.Extend(p.bounds());
   return box;
 }
 
@@ -70,7 +51,7 @@ bool RayCastReflectiveCentroid(const std::vector<Primitive>& parts_b,
                                Eigen::Vector3d* centroid_in_b,
                                double* spread_m) {
   const Aabb box = BoundsOf(parts_b);
-  const Eigen::Vector3d centre = 0.5 * (box.min + box.max);
+  const Eigen::Vector3d centre = box.Center();
   const double radius = 0.5 * (box.max - box.min).norm();
   const Eigen::Vector3d u = u_in_b.normalized();
   const Eigen::Vector3d e1 = u.unitOrthogonal();
@@ -84,18 +65,19 @@ bool RayCastReflectiveCentroid(const std::vector<Primitive>& parts_b,
       Ray ray;
       ray.origin = centre + 2.0 * radius * u + (i * spacing_m) * e1 + (j * spacing_m) * e2;
       ray.direction = -u;
-      double through = 1.0, t_min = 0.0, t = 0.0;
-      const Primitive* hit = nullptr;
-      while (through > 1e-6 && NearestHit(parts_b, ray, t_min, &t, &hit)) {
-        const Material& m = hit->material();
+      double through = 1.0, t_min = 0.0;
+      RayHit hit;
+      while (through > 1e-6 && IntersectBruteForce(parts_b, ray, t_min,
+                                                   std::numeric_limits<double>::infinity(), &hit)) {
+        const Material& m = parts_b[static_cast<size_t>(hit.primitive)].material();
         if (m.type == SurfaceType::kDiffuse) break;
-        const Eigen::Vector3d p = ray.origin + t * ray.direction;
+        const Eigen::Vector3d p = ray.origin + hit.t * ray.direction;
         const double w = through * m.return_probability;
         weight += w;
         sum += w * p;
         second += w * p * p.transpose();
         through *= 1.0 - m.return_probability;
-        t_min = t + 1e-6;
+        t_min = hit.t + 1e-6;
       }
     }
   }

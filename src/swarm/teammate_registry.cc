@@ -32,7 +32,7 @@ void ApplySigmaFloors(const SwarmOptions& so, Eigen::Matrix<double, 6, 6>* C) {
 }
 
 // k's derived block came through teammate j (j is in its chain).
-bool ChainEndsAt(const TeammateInfo& info_k, int j) {
+bool CameThrough(const TeammateInfo& info_k, int j) {
   return info_k.derived_through.count(j) > 0;
 }
 
@@ -103,8 +103,7 @@ void TeammateRegistry::AddMatched(int64_t t_k, const teammate::ScanResult& detec
     C.diagonal().head<3>().setConstant(sigma_r * sigma_r);
     C.diagonal().tail<3>().setConstant(sigma_p * sigma_p);
     AddBlock(id.drone_id, t_k, T_Gi_Gj, C, x, P);
-    SetProvenance(false, {}, &teammates_[id.drone_id]);
-    teammates_[id.drone_id].second_hand = false;
+    SetProvenance(false, false, {}, &teammates_[id.drone_id]);
     IdentificationEvent event = Event(id.drone_id, t_k, "trajectory_match", T_Gi_Gj);
     event.mean_residual_m = id.mean_residual_m;
     report->identifications.push_back(event);
@@ -131,11 +130,10 @@ void TeammateRegistry::AddMutual(int64_t t_k, SwarmState* x, Eigen::MatrixXd* P,
     }
     if (!detector_->AddIdentifiedTeammate(j, t_k, T_Gi_Gj.R_Ga_Gb(), T_Gi_Gj.p_Gb_in_Ga)) continue;
     AddBlock(j, t_k, T_Gi_Gj, C, x, P);
-    teammates_[j].second_hand = true;
     // The inverse of an edge j derived itself stays derived, through
     // teammates j did not name: any teammate heard so far may be in its chain.
     const bool derived = pending.source == net::ExtrinsicSource::kGraph;
-    SetProvenance(derived, derived ? HeardTeammates(teammates_, j) : std::map<int, int64_t>(),
+    SetProvenance(true, derived, derived ? HeardTeammates(teammates_, j) : std::map<int, int64_t>(),
                   &teammates_[j]);
     report->identifications.push_back(Event(j, t_k, "teammate_match", T_Gi_Gj));
   }
@@ -162,7 +160,7 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
       // A block k already holds follows a new composition while it has
       // little of its own, and only through the teammate it came through.
       if (x->HasTeammate(k) &&
-          !(teammates_[k].via_graph && FollowsSource(k) && ChainEndsAt(teammates_[k], j))) {
+          !(teammates_[k].via_graph && FollowsSource(k) && CameThrough(teammates_[k], j))) {
         continue;
       }
       if (ChainPassesThrough(info_j, k, teammates_)) continue;
@@ -196,13 +194,12 @@ void TeammateRegistry::AddThroughTeammates(int64_t t_k, SwarmState* x, Eigen::Ma
     }
     const int n = static_cast<int>(P->rows());
     AddBlock(k, t_k, c.T_Gi_Gk, C, x, P);
-    teammates_[k].second_hand = true;
     P->block(n, 0, 6, n) = cross;
     P->block(0, n, n, 6) = cross.transpose();
     // k's chain: j's (empty when j is first-hand) and j itself.
     std::map<int, int64_t> through = teammates_[c.via].derived_through;
     through[c.via] = teammates_[c.via].session_start_ns;
-    SetProvenance(true, std::move(through), &teammates_[k]);
+    SetProvenance(true, true, std::move(through), &teammates_[k]);
     IdentificationEvent event = Event(k, t_k, "graph", c.T_Gi_Gk);
     event.via_drone_id = c.via;
     report->identifications.push_back(event);

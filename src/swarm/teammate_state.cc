@@ -12,7 +12,9 @@ bool Finite(const net::EgoStateMessage& m) {
          m.cov_p_bj_in_Gj.allFinite() && m.cov_v_bj_in_Gj.allFinite();
 }
 
-void SetProvenance(bool via_graph, std::map<int, int64_t> derived_through, TeammateInfo* info) {
+void SetProvenance(bool second_hand, bool via_graph, std::map<int, int64_t> derived_through,
+                   TeammateInfo* info) {
+  info->second_hand = second_hand;
   info->via_graph = via_graph;
   info->derived_through = std::move(derived_through);
   info->observations_fused = 0;

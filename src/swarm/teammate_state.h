@@ -61,10 +61,12 @@ struct TeammateInfo {
 
 using Teammates = std::map<int, TeammateInfo>;
 
-/// A block was just added for this teammate: where it came from (a derived
-/// block's chain: the teammates it may pass through, with their sessions; a
+/// A block was just added for this teammate: where it came from (from a
+/// teammate at all: `second_hand`; through the graph, with a derived block's
+/// chain: the teammates it may pass through, with their sessions; a
 /// first-hand one: none) and no own observations in it yet.
-void SetProvenance(bool via_graph, std::map<int, int64_t> derived_through, TeammateInfo* info);
+void SetProvenance(bool second_hand, bool via_graph, std::map<int, int64_t> derived_through,
+                   TeammateInfo* info);
 
 /// The session a teammate is in now, as far as its messages told (0: none heard).
 int64_t SessionOf(const Teammates& teammates, int id);

@@ -3,6 +3,19 @@
 #include <cmath>
 
 namespace swarmlio::teammate {
+namespace {
+
+// A tape band of half extents a (x) and b (y) around the body origin.
+AirframeDescription BandOf(double a, double b) {
+  AirframeDescription band;
+  band.reflector_shape = ReflectorShape::kBand;
+  band.reflector_half_extents_m.x() = a;
+  band.reflector_half_extents_m.y() = b;
+  band.reflector_centre_in_body_m.setZero();
+  return band;
+}
+
+}  // namespace
 
 Eigen::Matrix3d ObservationCovariance(const Eigen::Vector3d& p_in_b,
                                       const ObservationOptions& options) {
@@ -16,15 +29,13 @@ Eigen::Matrix3d ObservationCovariance(const Eigen::Vector3d& p_in_b,
 }
 
 Eigen::Vector3d TapeCentroidInBody(const Eigen::Vector3d& u_in_bj, double a, double b) {
-  const double ux = u_in_bj.x(), uy = u_in_bj.y();
-  const double denominator = b * std::abs(ux) + a * std::abs(uy);
-  // Seen from straight above or below, the band shows no side face.
-  if (denominator <= 1e-9) return Eigen::Vector3d::Zero();
-  return (a * b / denominator) * Eigen::Vector3d(ux, uy, 0.0);
+  return VisibleReflectorCentroid(BandOf(a, b), u_in_bj);
 }
 
-ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptions& options,
-                             const Eigen::Matrix3d* R_bi_bj, const AirframeDescription* airframe) {
+ClusterCentre EstimateCentre(const PointCluster& cluster,
+                             const ObservationOptions& options,
+                             const Eigen::Matrix3d* R_bi_bj,
+                             const AirframeDescription* airframe) {
   ClusterCentre centre;
   const bool tape_only = cluster.num_reflective_points >= options.min_reflective_points;
   if (tape_only) {
@@ -36,21 +47,24 @@ ClusterCentre EstimateCentre(const PointCluster& cluster, const ObservationOptio
   }
   const double range = centre.p_in_b.norm();
   if (range <= 0.0) return centre;
-  if (tape_only && airframe != nullptr && R_bi_bj != nullptr) {
+  // The teammate's announced body, else the options' band (when configured).
+  const AirframeDescription options_band =
+      BandOf(options.tape_half_length_m, options.tape_half_width_m);
+  const AirframeDescription* body =
+      airframe != nullptr ? airframe : (options.UsesTapeBand() ? &options_band : nullptr);
+  if (tape_only && body != nullptr && R_bi_bj != nullptr) {
     const Eigen::Vector3d u_in_bj = R_bi_bj->transpose() * (-centre.p_in_b / range);
-    centre.p_in_b -= *R_bi_bj * (airframe->reflector_centre_in_body_m +
-                                 VisibleReflectorCentroid(*airframe, u_in_bj));
-  } else if (tape_only && options.UsesTapeBand() && R_bi_bj != nullptr) {
-    const Eigen::Vector3d u_in_bj = R_bi_bj->transpose() * (-centre.p_in_b / range);
-    centre.p_in_b -= *R_bi_bj * TapeCentroidInBody(u_in_bj, options.tape_half_length_m,
-                                                  options.tape_half_width_m);
+    centre.p_in_b -=
+        *R_bi_bj * (body->reflector_centre_in_body_m + VisibleReflectorCentroid(*body, u_in_bj));
   } else {
     centre.p_in_b += options.centroid_depth_offset_m * centre.p_in_b / range;
   }
   return centre;
 }
 
-TeammateObservation MakeObservation(int drone_id, int64_t stamp_ns, const PointCluster& cluster,
+TeammateObservation MakeObservation(int drone_id,
+                                    int64_t stamp_ns,
+                                    const PointCluster& cluster,
                                     const Eigen::Vector3d& v_bj_in_bi,
                                     const ObservationOptions& options,
                                     const Eigen::Matrix3d* R_bi_bj,

@@ -92,8 +92,8 @@ TEST(CanRelay, ADerivedTeammateRelaysOnceItNoLongerLeansOnItsIntermediary) {
   Teammates teammates;
   teammates[j].session_start_ns = 100;
   teammates[k].session_start_ns = 200;
-  SetProvenance(false, {}, &teammates[j]);
-  SetProvenance(true, {{j, 100}}, &teammates[k]);
+  SetProvenance(false, false, {}, &teammates[j]);
+  SetProvenance(true, true, {{j, 100}}, &teammates[k]);
   SwarmOptions options;
   options.graph_derived_min_observations = 20;
   EXPECT_TRUE(CanRelay(teammates[j], x, teammates, options));  // first-hand
@@ -127,7 +127,7 @@ TEST(HeardTeammates, StandsInForAnUnnamedChain) {
   teammates[silent].last_seen_ns = 8;  // seen, never heard
   const std::map<int, int64_t> chain = HeardTeammates(teammates, k);
   EXPECT_EQ(chain, (std::map<int, int64_t>{{j, 100}, {m, 300}}));
-  SetProvenance(true, chain, &teammates[k]);
+  SetProvenance(true, true, chain, &teammates[k]);
   SwarmState x;
   x.AddTeammate(j, GlobalExtrinsic());
   x.AddTeammate(k, GlobalExtrinsic());
@@ -146,7 +146,7 @@ TEST(ChainPassesThrough, RefusesALoopThroughTheSameSessionOnly) {
   const int j = 1, k = 2, m = 3;
   Teammates teammates;
   teammates[j].session_start_ns = 100;
-  SetProvenance(true, {{j, 100}}, &teammates[k]);
+  SetProvenance(true, true, {{j, 100}}, &teammates[k]);
   EXPECT_TRUE(ChainPassesThrough(teammates[k], j, teammates));
   EXPECT_FALSE(ChainPassesThrough(teammates[k], m, teammates));
   teammates[j].session_start_ns = 101;

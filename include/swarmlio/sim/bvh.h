@@ -17,7 +17,8 @@ struct RayHit {
   bool hit() const { return primitive >= 0; }
 };
 
-/// Closest hit over all `primitives` by testing each one (reference for tests).
+/// Closest hit over all `primitives` by testing each one (reference for tests;
+/// the ray casts at a few body parts, sim::RayCastReflectiveCentroid).
 bool IntersectBruteForce(const std::vector<Primitive>& primitives, const Ray& ray, double t_min,
                          double t_max, RayHit* hit);
 
