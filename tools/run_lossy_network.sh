@@ -12,7 +12,7 @@
 #
 # SCENARIO_SEEDS (default: the file's seed) lists scenario seeds; one without a run in
 # OUT/<name>/seed<S>/ is simulated here (swarmlio_sim --seed S --imperfections
-# $IMPERFECTIONS, default ideal) and replayed lossless first.
+# $IMPERFECTIONS, default realistic) and replayed lossless first.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -20,7 +20,7 @@ BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
 OUT="${OUT:-$ROOT/results/scenarios}"
 REPLAY="$BUILD_DIR/tools/replay/swarmlio_replay"
 SIM="$BUILD_DIR/tools/sim/swarmlio_sim"
-IMPERFECTIONS="${IMPERFECTIONS:-ideal}"
+IMPERFECTIONS="${IMPERFECTIONS:-realistic}"
 SEEDS="${SEEDS:-1 2 3}"
 LOSS="${LOSS:-0.2}"
 LATENCY_S="${LATENCY_S:-0.1}"
