@@ -10,11 +10,11 @@ using Clock = std::chrono::steady_clock;
 }  // namespace
 
 FilterBackEnd::FilterBackEnd(const OdometryOptions& options, LocalMap* map,
-                             ImuPropagator* propagator)
+                             ImuPropagator* propagator, const ParallelFor* parallel)
     : options_(options),
       map_(map),
       propagator_(propagator),
-      associator_(map, options.association),
+      associator_(map, options.association, parallel),
       update_(options.update) {}
 
 void FilterBackEnd::Update(const UpdateRequest& request,

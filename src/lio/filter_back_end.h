@@ -12,14 +12,17 @@
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/odometry_options.h"
+#include "swarmlio/lio/parallel_for.h"
 #include "swarmlio/lio/scan_association.h"
 
 namespace swarmlio::lio::internal {
 
 class FilterBackEnd final : public BackEnd {
  public:
-  /// `map` and `propagator` must outlive the back end.
-  FilterBackEnd(const OdometryOptions& options, LocalMap* map, ImuPropagator* propagator);
+  /// `map`, `propagator` and `parallel` (may be null: one thread) must
+  /// outlive the back end.
+  FilterBackEnd(const OdometryOptions& options, LocalMap* map, ImuPropagator* propagator,
+                const ParallelFor* parallel = nullptr);
 
   // The propagator is the filter's process model: no interval of its own.
   void StartInterval(int64_t, const ImuSample&, double, const EgoState&) override {}

@@ -57,7 +57,8 @@ Status Odometry::CreateBackEnd() {
   if (options_.estimator == EstimatorKind::kWindow) {
     return window::WindowBackEnd::Create(options_, &im.map, im.propagator.get(), &im.back_end);
   }
-  im.back_end = std::make_unique<internal::FilterBackEnd>(options_, &im.map, im.propagator.get());
+  im.back_end = std::make_unique<internal::FilterBackEnd>(options_, &im.map, im.propagator.get(),
+                                                          &im.parallel);
   return Status::Ok();
 }
 

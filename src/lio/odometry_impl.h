@@ -13,6 +13,7 @@
 #include "swarmlio/lio/in_flight_alignment.h"
 #include "swarmlio/lio/input_synchronizer.h"
 #include "swarmlio/lio/local_map.h"
+#include "swarmlio/lio/parallel_for.h"
 #include "swarmlio/lio/odometry.h"
 #include "swarmlio/lio/preprocess.h"
 #include "src/lio/back_end.h"
@@ -43,6 +44,7 @@ struct Odometry::Impl {
   std::unique_ptr<ImuPropagator> propagator;
   std::unique_ptr<Preprocess> preprocess;
   LocalMap map;
+  ParallelFor parallel;  // the back end's parallel loops (options.threads)
   std::unique_ptr<internal::BackEnd> back_end;  // filter or window (options.estimator)
   std::deque<ImuSample> imu_queue;                   // after initialization, not yet propagated
   InputSynchronizer input;  // scans waiting for the IMU, the IMU stamps' order
@@ -66,7 +68,7 @@ struct Odometry::Impl {
   std::vector<Eigen::Vector3d> undistorted;
 
   Impl(const OdometryOptions& options)
-      : map(options.map), input(options.max_queued_scans) {}
+      : map(options.map), parallel(options.threads), input(options.max_queued_scans) {}
 };
 
 }  // namespace swarmlio::lio

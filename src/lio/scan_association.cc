@@ -11,12 +11,43 @@ double AssociationStats::MinNormalInformation() const {
       .eigenvalues()(0);
 }
 
-ScanAssociator::ScanAssociator(const LocalMap* map, const ScanAssociationOptions& options)
-    : map_(map), options_(options) {}
+ScanAssociator::ScanAssociator(const LocalMap* map, const ScanAssociationOptions& options,
+                               const ParallelFor* parallel)
+    : map_(map), options_(options), parallel_(parallel) {}
 
 void ScanAssociator::Reset(const std::vector<Eigen::Vector3d>* points_in_b) {
   points_in_b_ = points_in_b;
   cache_.assign(points_in_b == nullptr ? 0 : points_in_b->size(), CachedPlane());
+}
+
+void ScanAssociator::SearchMoved(const Eigen::Matrix3d& R_G_b, const Eigen::Vector3d& p_b_in_G) {
+  const std::vector<Eigen::Vector3d>& points = *points_in_b_;
+  const double research_sq = options_.research_distance_m * options_.research_distance_m;
+  searched_.assign(points.size(), 0);
+  // Each point reads the map and writes only its own cache entry and flag:
+  // the same result for any thread count.
+  const auto search = [&](int64_t begin, int64_t end) {
+    std::vector<Neighbor> neighbors;
+    neighbors.reserve(static_cast<size_t>(options_.num_neighbors));
+    for (int64_t i = begin; i < end; ++i) {
+      const Eigen::Vector3d q_in_G = R_G_b * points[static_cast<size_t>(i)] + p_b_in_G;
+      CachedPlane& cached = cache_[static_cast<size_t>(i)];
+      if (research_sq != 0.0 && (q_in_G - cached.searched_at_in_G).squaredNorm() <= research_sq) {
+        continue;
+      }
+      cached.searched_at_in_G = q_in_G;
+      map_->KNearest(q_in_G, options_.num_neighbors, &neighbors);
+      cached.has_plane = FitPlane(neighbors, options_.plane, &cached.plane) == PlaneFitStatus::kOk;
+      searched_[static_cast<size_t>(i)] = 1;
+    }
+  };
+  constexpr int64_t kGrain = 128;  // points per task
+  const int64_t n = static_cast<int64_t>(points.size());
+  if (parallel_ != nullptr) {
+    parallel_->Run(n, kGrain, search);
+  } else {
+    search(0, n);
+  }
 }
 
 Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespondence>* out) {
@@ -27,26 +58,21 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
   }
   const Eigen::Matrix3d R_G_b = x.ego.q_G_b.toRotationMatrix();
   const Eigen::Vector3d& p_b_in_G = x.ego.p_b_in_G;
-  const double research_sq = options_.research_distance_m * options_.research_distance_m;
   const double weight = 1.0 / (options_.point_stddev_m * options_.point_stddev_m);
   const std::vector<Eigen::Vector3d>& points = *points_in_b_;
   stats_.num_points = static_cast<int>(points.size());
+  SearchMoved(R_G_b, p_b_in_G);
   out->reserve(points.size());
   planes_.clear();
   matched_.clear();
   for (size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3d q_in_G = R_G_b * points[i] + p_b_in_G;
-    CachedPlane& cached = cache_[i];
-    if (research_sq == 0.0 || (q_in_G - cached.searched_at_in_G).squaredNorm() > research_sq) {
-      cached.searched_at_in_G = q_in_G;
-      map_->KNearest(q_in_G, options_.num_neighbors, &neighbors_);
-      cached.has_plane = FitPlane(neighbors_, options_.plane, &cached.plane) == PlaneFitStatus::kOk;
-      ++stats_.num_searched;
-    }
+    stats_.num_searched += searched_[i];
+    const CachedPlane& cached = cache_[i];
     if (!cached.has_plane) {
       ++stats_.num_no_plane;
       continue;
     }
+    const Eigen::Vector3d q_in_G = R_G_b * points[i] + p_b_in_G;
     const double z = cached.plane.SignedDistance(q_in_G);
     if (!(std::abs(z) < options_.residual_gate_factor * std::sqrt(points[i].norm()))) {
       ++stats_.num_gated;

@@ -61,6 +61,11 @@ struct OdometryOptions {
   /// window back end applies it to each scan leaving the window, with that
   /// scan's last association.
   bool insert_matched_points = false;
+  /// (experimental) Threads of the per-scan work that runs in parallel (the neighbour
+  /// searches and plane fits of the scan association); 0 = the machine's,
+  /// capped at 4. Trajectories are bit-identical for any value (docs/lio.md
+  /// "Threads").
+  int threads = 0;
 
   template <class V>
   void VisitFields(V&& v) {
@@ -77,6 +82,9 @@ struct OdometryOptions {
     v("imu_time_offset_s", imu_time_offset_s,
       FieldSpec::InRange(-1.0, 1.0, "s", "subtracted from IMU stamps (IMU clock minus LiDAR clock)"));
     config::VisitExperimental(v, [&](auto& x) {
+      x("threads", threads,
+        FieldSpec::InRange(0.0, 256.0, "", "threads of the scan association; 0 = the machine's, "
+                                           "at most 4 (results identical for any value)"));
       x("imu_init", imu_init);
       x("in_flight", in_flight);
       x("association", association);

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,7 @@
 #include "swarmlio/common/option_fields.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/lio/local_map.h"
+#include "swarmlio/lio/parallel_for.h"
 #include "swarmlio/lio/plane_fit.h"
 #include "swarmlio/state/swarm_state.h"
 
@@ -135,8 +137,12 @@ struct AssociationStats {
 
 class ScanAssociator {
  public:
-  /// `map` must outlive the associator and not change while it is in use.
-  ScanAssociator(const LocalMap* map, const ScanAssociationOptions& options);
+  /// `map` must outlive the associator and not change while it is in use;
+  /// `parallel` (may be null: one thread), when given, runs the neighbour
+  /// searches and plane fits and must outlive the associator. The result is
+  /// the same for any thread count.
+  ScanAssociator(const LocalMap* map, const ScanAssociationOptions& options,
+                 const ParallelFor* parallel = nullptr);
 
   /// Starts a new scan: `points_in_b` (body frame at the scan end) must
   /// outlive the calls to Associate(). Forgets cached neighbours.
@@ -165,11 +171,17 @@ class ScanAssociator {
   // max_normal_stddev_rad > 0 (which so switches the whole rule off).
   void ApplyNoisyPlaneRule(std::vector<PlaneCorrespondence>* out);
 
+  // The neighbour search and plane fit of every point that moved more than
+  // research_distance_m since its last search (all of them after Reset()),
+  // at the estimate (R_G_b, p_b_in_G); marks them in searched_.
+  void SearchMoved(const Eigen::Matrix3d& R_G_b, const Eigen::Vector3d& p_b_in_G);
+
   const LocalMap* map_;
   ScanAssociationOptions options_;
   const std::vector<Eigen::Vector3d>* points_in_b_ = nullptr;
   std::vector<CachedPlane> cache_;
-  std::vector<Neighbor> neighbors_;  // scratch
+  const ParallelFor* parallel_ = nullptr;
+  std::vector<uint8_t> searched_;     // scratch: 1 where the last call searched
   std::vector<const Plane*> planes_;  // scratch: the plane of each correspondence
   std::vector<int> matched_;          // the scan point of each correspondence
   AssociationStats stats_;
