@@ -1,7 +1,6 @@
 #include "src/io/mcap_compression.h"
 
 #include <lz4frame.h>
-#include <zlib.h>
 #include <zstd.h>
 
 #include <memory>
@@ -87,10 +86,6 @@ Status DecompressLz4Frame(const uint8_t* data, size_t size, std::vector<uint8_t>
 }
 
 }  // namespace
-
-uint32_t Crc32(uint32_t crc, const uint8_t* data, size_t size) {
-  return static_cast<uint32_t>(crc32_z(crc, data, size));
-}
 
 bool IsSupportedMcapCompression(const std::string& compression) {
   return compression.empty() || compression == "zstd" || compression == "lz4";

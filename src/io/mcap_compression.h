@@ -1,6 +1,6 @@
 // Chunk compression of MCAP files: "" (none), "zstd" (libzstd) and "lz4"
-// (the LZ4 *frame* format, liblz4's lz4frame), and the CRC32 MCAP uses
-// (zlib's). Decompression never trusts a size field: the output must be
+// (the LZ4 *frame* format, liblz4's lz4frame); the CRC-32 MCAP uses is in
+// crc32.h. Decompression never trusts a size field: the output must be
 // exactly the chunk's stated uncompressed size, which is sanity-checked
 // against the stored size before anything is allocated.
 #pragma once
@@ -13,9 +13,6 @@
 #include "swarmlio/common/status.h"
 
 namespace swarmlio::io::internal {
-
-/// CRC-32 (zlib, ISO-HDLC) of `size` bytes, continuing from `crc` (0 to start).
-uint32_t Crc32(uint32_t crc, const uint8_t* data, size_t size);
 
 /// True for "", "zstd" and "lz4".
 bool IsSupportedMcapCompression(const std::string& compression);

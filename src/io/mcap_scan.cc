@@ -5,6 +5,7 @@
 #include <system_error>
 #include <utility>
 
+#include "src/io/crc32.h"
 #include "src/io/mcap_compression.h"
 #include "src/io/mcap_format.h"
 #include "src/io/ros_message_reader.h"
@@ -224,7 +225,7 @@ Status Scanner::OnChunk(const std::vector<uint8_t>& content, uint64_t file_offse
   std::vector<uint8_t> records;
   status = DecompressMcapChunk(chunk.compression, content.data() + reader.position(),
                                reader.remaining(), chunk.uncompressed_bytes, &records);
-  if (status.ok() && crc != 0 && Crc32(0, records.data(), records.size()) != crc) {
+  if (status.ok() && crc != 0 && Crc32(records.data(), records.size()) != crc) {
     status = Status::DataLoss("uncompressed CRC mismatch");
   }
   if (!status.ok()) return Damage(file_offset, record_bytes, where + ": " + status.message());
@@ -249,7 +250,7 @@ Status Scanner::ReadRecordAt(uint64_t offset, uint8_t* op, std::vector<uint8_t>*
   if (!file_->Read(offset + kMcapRecordPrefixBytes, static_cast<size_t>(length), content)) {
     return Status::IoError("bag '" + path_ + "': read failed at offset " + std::to_string(offset));
   }
-  crc_ = Crc32(crc_, prefix.data(), prefix.size());
+  crc_ = Crc32(prefix.data(), prefix.size(), crc_);
   return Status::Ok();
 }
 
@@ -266,7 +267,7 @@ Status Scanner::Run() {
     return Status::DataLoss("bag '" + path_ + "': not an MCAP file (no magic)");
   }
   out_->path = path_;
-  crc_ = Crc32(0, magic.data(), magic.size());
+  crc_ = Crc32(magic.data(), magic.size());
   uint64_t offset = kMcapMagicBytes;
   std::vector<uint8_t> content;
   for (bool first = true;; first = false) {
@@ -291,7 +292,7 @@ Status Scanner::Run() {
       }
       return Status::Ok();
     }
-    crc_ = Crc32(crc_, content.data(), content.size());
+    crc_ = Crc32(content.data(), content.size(), crc_);
     if (op == kMcapHeader) {
       RosMessageReader reader(content.data(), content.size());
       static_cast<void>(reader.ReadString("profile", &out_->profile));
