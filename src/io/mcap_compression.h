@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "src/io/byte_buffer.h"
 #include "swarmlio/common/status.h"
 
 namespace swarmlio::io::internal {
@@ -17,14 +18,19 @@ namespace swarmlio::io::internal {
 /// True for "", "zstd" and "lz4".
 bool IsSupportedMcapCompression(const std::string& compression);
 
-/// Decompresses `size` stored bytes into exactly `uncompressed_size` bytes;
-/// DataLoss (with the reason) if they do not, or if the size is implausible
-/// for the stored bytes (a corrupt field, refused before allocating).
-Status DecompressMcapChunk(const std::string& compression,
-                           const uint8_t* data,
-                           size_t size,
-                           uint64_t uncompressed_size,
-                           std::vector<uint8_t>* out);
+/// A chunk's records from its `size` stored bytes at `data`: without
+/// compression ("") the stored bytes themselves (*records = data, once
+/// `uncompressed_size` is checked to equal `size`), else decompressed into
+/// exactly `uncompressed_size` bytes of *buffer (*records = buffer->data()).
+/// DataLoss (with the reason) if they do not decompress to exactly that
+/// size, or if the size is implausible for the stored bytes (a corrupt
+/// field, refused before allocating).
+Status McapChunkRecords(const std::string& compression,
+                        const uint8_t* data,
+                        size_t size,
+                        uint64_t uncompressed_size,
+                        ByteBuffer* buffer,
+                        const uint8_t** records);
 
 /// Compresses `size` bytes with `compression` ("" copies them).
 Status CompressMcapChunk(const std::string& compression,
