@@ -40,7 +40,7 @@ PACKAGES=(
   libnanoflann-dev robin-map-dev libtbb-dev
   libcairo2-dev
   libsodium-dev
-  libzstd-dev liblz4-dev zlib1g-dev libsqlite3-dev
+  libzstd-dev liblz4-dev zlib1g-dev libisal-dev libsqlite3-dev
   parallel
 )
 # The sweep test starts a single-node Slurm cluster (tests/sweep/slurm_test.sh;

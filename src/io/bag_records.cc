@@ -33,11 +33,15 @@ BagFile::BagFile(const std::string& path, uint64_t size)
 
 bool BagFile::Read(uint64_t offset, size_t count, std::vector<uint8_t>* bytes) {
   bytes->resize(count);
+  return Read(offset, count, bytes->data());
+}
+
+bool BagFile::Read(uint64_t offset, size_t count, uint8_t* bytes) {
   if (count == 0) return true;
   if (offset > size_ || count > size_ - offset) return false;
   file_.clear();
   file_.seekg(static_cast<std::streamoff>(offset));
-  file_.read(reinterpret_cast<char*>(bytes->data()), static_cast<std::streamsize>(count));
+  file_.read(reinterpret_cast<char*>(bytes), static_cast<std::streamsize>(count));
   return static_cast<size_t>(file_.gcount()) == count;
 }
 

@@ -74,6 +74,9 @@ class BagFile {
 
   /// Reads `count` bytes at `offset`; false if the file ends first.
   bool Read(uint64_t offset, size_t count, std::vector<uint8_t>* bytes);
+  /// The same into `bytes`, which has room for `count` (straight from the
+  /// kernel into it for large reads).
+  bool Read(uint64_t offset, size_t count, uint8_t* bytes);
 
   /// Reads the record at `offset`, which must end by `limit`.
   Status ReadRecord(uint64_t offset, uint64_t limit, const std::string& what, Record* record);

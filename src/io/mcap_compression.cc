@@ -1,7 +1,6 @@
 #include "src/io/mcap_compression.h"
 
 #include <lz4frame.h>
-#include <zlib.h>
 #include <zstd.h>
 
 #include <memory>
@@ -34,7 +33,7 @@ Status CheckSizes(const std::string& compression, size_t stored, uint64_t uncomp
   return Status::Ok();
 }
 
-Status DecompressZstd(const uint8_t* data, size_t size, std::vector<uint8_t>* out) {
+Status DecompressZstd(const uint8_t* data, size_t size, ByteBuffer* out) {
   const size_t written = ZSTD_decompress(out->data(), out->size(), data, size);
   if (ZSTD_isError(written)) {
     return Status::DataLoss(std::string("zstd chunk does not decompress: ") +
@@ -51,7 +50,7 @@ struct Lz4ContextDeleter {
   void operator()(LZ4F_dctx* context) const { LZ4F_freeDecompressionContext(context); }
 };
 
-Status DecompressLz4Frame(const uint8_t* data, size_t size, std::vector<uint8_t>* out) {
+Status DecompressLz4Frame(const uint8_t* data, size_t size, ByteBuffer* out) {
   LZ4F_dctx* raw = nullptr;
   if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) {
     return Status::Internal("cannot create an LZ4 decompression context");
@@ -88,19 +87,16 @@ Status DecompressLz4Frame(const uint8_t* data, size_t size, std::vector<uint8_t>
 
 }  // namespace
 
-uint32_t Crc32(uint32_t crc, const uint8_t* data, size_t size) {
-  return static_cast<uint32_t>(crc32_z(crc, data, size));
-}
-
 bool IsSupportedMcapCompression(const std::string& compression) {
   return compression.empty() || compression == "zstd" || compression == "lz4";
 }
 
-Status DecompressMcapChunk(const std::string& compression,
-                           const uint8_t* data,
-                           size_t size,
-                           uint64_t uncompressed_size,
-                           std::vector<uint8_t>* out) {
+Status McapChunkRecords(const std::string& compression,
+                        const uint8_t* data,
+                        size_t size,
+                        uint64_t uncompressed_size,
+                        ByteBuffer* buffer,
+                        const uint8_t** records) {
   if (!IsSupportedMcapCompression(compression)) {
     return Status::DataLoss("unsupported chunk compression '" + compression +
                             "' (supported: none, zstd, lz4)");
@@ -120,12 +116,15 @@ Status DecompressMcapChunk(const std::string& compression,
     }
   }
   if (compression.empty()) {
-    out->assign(data, data + size);
+    *records = data;  // read in place
     return Status::Ok();
   }
-  out->assign(static_cast<size_t>(uncompressed_size), 0);
-  if (compression == "zstd") return DecompressZstd(data, size, out);
-  return DecompressLz4Frame(data, size, out);
+  // Every byte is written by the decompressor (or the size check fails).
+  buffer->Resize(static_cast<size_t>(uncompressed_size));
+  SWARMLIO_RETURN_IF_ERROR(compression == "zstd" ? DecompressZstd(data, size, buffer)
+                                                 : DecompressLz4Frame(data, size, buffer));
+  *records = buffer->data();
+  return Status::Ok();
 }
 
 Status CompressMcapChunk(const std::string& compression,

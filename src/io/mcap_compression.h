@@ -1,6 +1,6 @@
 // Chunk compression of MCAP files: "" (none), "zstd" (libzstd) and "lz4"
-// (the LZ4 *frame* format, liblz4's lz4frame), and the CRC32 MCAP uses
-// (zlib's). Decompression never trusts a size field: the output must be
+// (the LZ4 *frame* format, liblz4's lz4frame); the CRC-32 MCAP uses is in
+// crc32.h. Decompression never trusts a size field: the output must be
 // exactly the chunk's stated uncompressed size, which is sanity-checked
 // against the stored size before anything is allocated.
 #pragma once
@@ -10,24 +10,27 @@
 #include <string>
 #include <vector>
 
+#include "src/io/byte_buffer.h"
 #include "swarmlio/common/status.h"
 
 namespace swarmlio::io::internal {
 
-/// CRC-32 (zlib, ISO-HDLC) of `size` bytes, continuing from `crc` (0 to start).
-uint32_t Crc32(uint32_t crc, const uint8_t* data, size_t size);
-
 /// True for "", "zstd" and "lz4".
 bool IsSupportedMcapCompression(const std::string& compression);
 
-/// Decompresses `size` stored bytes into exactly `uncompressed_size` bytes;
-/// DataLoss (with the reason) if they do not, or if the size is implausible
-/// for the stored bytes (a corrupt field, refused before allocating).
-Status DecompressMcapChunk(const std::string& compression,
-                           const uint8_t* data,
-                           size_t size,
-                           uint64_t uncompressed_size,
-                           std::vector<uint8_t>* out);
+/// A chunk's records from its `size` stored bytes at `data`: without
+/// compression ("") the stored bytes themselves (*records = data, once
+/// `uncompressed_size` is checked to equal `size`), else decompressed into
+/// exactly `uncompressed_size` bytes of *buffer (*records = buffer->data()).
+/// DataLoss (with the reason) if they do not decompress to exactly that
+/// size, or if the size is implausible for the stored bytes (a corrupt
+/// field, refused before allocating).
+Status McapChunkRecords(const std::string& compression,
+                        const uint8_t* data,
+                        size_t size,
+                        uint64_t uncompressed_size,
+                        ByteBuffer* buffer,
+                        const uint8_t** records);
 
 /// Compresses `size` bytes with `compression` ("" copies them).
 Status CompressMcapChunk(const std::string& compression,

@@ -1,16 +1,23 @@
 #include "src/io/mcap_scan.h"
 
+#include <algorithm>
+#include <cstddef>
 #include <filesystem>
 #include <limits>
 #include <system_error>
 #include <utility>
 
+#include "src/io/crc32.h"
 #include "src/io/mcap_compression.h"
 #include "src/io/mcap_format.h"
 #include "src/io/ros_message_reader.h"
 
 namespace swarmlio::io::internal {
 namespace {
+
+// Chunks McapChunkCache keeps: the topic streams of one file (IMU, lidar,
+// ground truth) are within a chunk or two of each other.
+constexpr size_t kKeptMcapChunks = 4;
 
 struct McapSchema {
   std::string name;
@@ -48,7 +55,8 @@ class Scanner {
  private:
   // Records damage: an error without recovery, else counted. `bytes` were lost.
   Status Damage(uint64_t offset, uint64_t bytes, const std::string& what);
-  Status ReadRecordAt(uint64_t offset, uint8_t* op, std::vector<uint8_t>* content);
+  // Reads the record at `offset` into content_ and adds its prefix to crc_.
+  Status ReadRecordAt(uint64_t offset, uint8_t* op);
   Status OnRecord(uint8_t op,
                   const uint8_t* content,
                   uint64_t size,
@@ -58,15 +66,21 @@ class Scanner {
   Status OnSchema(RosMessageReader* reader);
   Status OnChannel(RosMessageReader* reader);
   Status OnMessage(RosMessageReader* reader, uint64_t content_offset, uint64_t size, int64_t chunk);
-  Status OnChunk(const std::vector<uint8_t>& content, uint64_t file_offset);
-  Status WalkChunk(const std::vector<uint8_t>& records, int64_t chunk, uint64_t file_offset);
+  Status OnChunk(uint64_t file_offset);
+  Status ChunkRecords(const McapChunk& chunk,
+                      const uint8_t* stored,
+                      uint32_t crc,
+                      const uint8_t** records);
+  Status WalkChunk(const uint8_t* records, uint64_t size, int64_t chunk, uint64_t file_offset);
 
   std::string path_;
   bool recover_;
   McapFile* out_;
   std::unique_ptr<BagFile> file_;
   uint64_t size_ = 0;
-  uint32_t crc_ = 0;
+  uint32_t crc_ = 0;         // of the data section so far
+  ByteBuffer content_;       // the current record's content
+  ByteBuffer decompressed_;  // the current chunk's records when compressed
   std::map<uint16_t, McapSchema> schemas_;
   std::map<uint16_t, uint32_t> channels_;  // id -> index into out_->channels
 };
@@ -177,14 +191,15 @@ Status Scanner::OnRecord(uint8_t op,
                     status.message());
 }
 
-Status Scanner::WalkChunk(const std::vector<uint8_t>& records,
+Status Scanner::WalkChunk(const uint8_t* records,
+                          uint64_t size,
                           int64_t chunk,
                           uint64_t file_offset) {
   uint64_t at = 0;
-  while (at < records.size()) {
-    const uint64_t left = records.size() - at;
+  while (at < size) {
+    const uint64_t left = size - at;
     const uint64_t length =
-        left < kMcapRecordPrefixBytes ? 0 : LoadLittleEndian<uint64_t>(records.data() + at + 1);
+        left < kMcapRecordPrefixBytes ? 0 : LoadLittleEndian<uint64_t>(records + at + 1);
     if (left < kMcapRecordPrefixBytes || length > left - kMcapRecordPrefixBytes) {
       return Damage(file_offset, left,
                     "chunk at offset " + std::to_string(file_offset) + ": record at chunk offset " +
@@ -192,16 +207,45 @@ Status Scanner::WalkChunk(const std::vector<uint8_t>& records,
     }
     const uint64_t content = at + kMcapRecordPrefixBytes;
     SWARMLIO_RETURN_IF_ERROR(
-        OnRecord(records[at], records.data() + content, length, content, chunk, file_offset));
+        OnRecord(records[at], records + content, length, content, chunk, file_offset));
     at = content + length;
   }
   return Status::Ok();
 }
 
-Status Scanner::OnChunk(const std::vector<uint8_t>& content, uint64_t file_offset) {
-  const uint64_t record_bytes = content.size() + kMcapRecordPrefixBytes;
+// The records of `chunk`, whose stored bytes (chunk.records_bytes) are at
+// `stored`: those bytes themselves when uncompressed, else decompressed into
+// decompressed_; checked against `crc` unless it is 0. Adds the stored bytes
+// to crc_; for an uncompressed chunk by combining the records' CRC, which is
+// the chunk's too, so each byte goes through the CRC once.
+Status Scanner::ChunkRecords(const McapChunk& chunk,
+                             const uint8_t* stored,
+                             uint32_t crc,
+                             const uint8_t** records) {
+  const size_t size = static_cast<size_t>(chunk.records_bytes);
+  uint32_t records_crc = 0;
+  if (chunk.compression.empty()) {
+    records_crc = Crc32(stored, size);
+    crc_ = Crc32Combine(crc_, records_crc, size);
+  } else {
+    crc_ = Crc32(stored, size, crc_);
+  }
+  SWARMLIO_RETURN_IF_ERROR(McapChunkRecords(chunk.compression, stored, size,
+                                            chunk.uncompressed_bytes, &decompressed_, records));
+  if (crc == 0) return Status::Ok();
+  if (!chunk.compression.empty()) {
+    records_crc = Crc32(*records, static_cast<size_t>(chunk.uncompressed_bytes));
+  }
+  if (records_crc != crc) return Status::DataLoss("uncompressed CRC mismatch");
+  return Status::Ok();
+}
+
+// A Chunk record, in content_; adds it to crc_.
+Status Scanner::OnChunk(uint64_t file_offset) {
+  const uint8_t* content = content_.data();
+  const uint64_t record_bytes = content_.size() + kMcapRecordPrefixBytes;
   const std::string where = "chunk at offset " + std::to_string(file_offset);
-  RosMessageReader reader(content.data(), content.size());
+  RosMessageReader reader(content, content_.size());
   uint64_t start_time = 0, end_time = 0;
   uint32_t crc = 0;
   McapChunk chunk;
@@ -215,41 +259,45 @@ Status Scanner::OnChunk(const std::vector<uint8_t>& content, uint64_t file_offse
     status = Status::DataLoss("records length " + std::to_string(chunk.records_bytes) + " but " +
                               std::to_string(reader.remaining()) + " bytes remain");
   }
-  if (!status.ok()) return Damage(file_offset, record_bytes, where + ": " + status.message());
+  if (!status.ok()) {
+    crc_ = Crc32(content, content_.size(), crc_);
+    return Damage(file_offset, record_bytes, where + ": " + status.message());
+  }
   if (!IsSupportedMcapCompression(chunk.compression)) {
     return Status::InvalidArgument("bag '" + path_ + "': " + where + " has compression '" +
                                    chunk.compression + "' (supported: none, zstd, lz4)");
   }
+  crc_ = Crc32(content, reader.position(), crc_);
   chunk.records_offset = file_offset + kMcapRecordPrefixBytes + reader.position();
-  std::vector<uint8_t> records;
-  status = DecompressMcapChunk(chunk.compression, content.data() + reader.position(),
-                               reader.remaining(), chunk.uncompressed_bytes, &records);
-  if (status.ok() && crc != 0 && Crc32(0, records.data(), records.size()) != crc) {
-    status = Status::DataLoss("uncompressed CRC mismatch");
-  }
+  const uint8_t* records = nullptr;
+  status = ChunkRecords(chunk, content + reader.position(), crc, &records);
   if (!status.ok()) return Damage(file_offset, record_bytes, where + ": " + status.message());
   out_->chunks.push_back(chunk);
-  return WalkChunk(records, static_cast<int64_t>(out_->chunks.size() - 1), file_offset);
+  return WalkChunk(records, chunk.uncompressed_bytes, static_cast<int64_t>(out_->chunks.size() - 1),
+                   file_offset);
 }
 
-Status Scanner::ReadRecordAt(uint64_t offset, uint8_t* op, std::vector<uint8_t>* content) {
-  std::vector<uint8_t> prefix;
+Status Scanner::ReadRecordAt(uint64_t offset, uint8_t* op) {
+  uint8_t prefix[kMcapRecordPrefixBytes];
   const uint64_t left = size_ - offset;
-  if (left < kMcapRecordPrefixBytes || !file_->Read(offset, kMcapRecordPrefixBytes, &prefix)) {
+  if (left < kMcapRecordPrefixBytes || !file_->Read(offset, sizeof(prefix), prefix)) {
     return Status::DataLoss("truncated: record at offset " + std::to_string(offset) +
                             " is cut off (" + std::to_string(left) + " bytes remain)");
   }
   *op = prefix[0];
-  const uint64_t length = LoadLittleEndian<uint64_t>(prefix.data() + 1);
+  const uint64_t length = LoadLittleEndian<uint64_t>(prefix + 1);
   if (length > left - kMcapRecordPrefixBytes) {
     return Status::DataLoss("truncated: record " + Hex(*op) + " at offset " +
                             std::to_string(offset) + " claims " + std::to_string(length) +
                             " bytes, " + std::to_string(left - kMcapRecordPrefixBytes) + " remain");
   }
+  // Straight from the file into the buffer the record is parsed (and, for
+  // an uncompressed chunk, its messages found) in.
+  uint8_t* content = content_.Resize(static_cast<size_t>(length));
   if (!file_->Read(offset + kMcapRecordPrefixBytes, static_cast<size_t>(length), content)) {
     return Status::IoError("bag '" + path_ + "': read failed at offset " + std::to_string(offset));
   }
-  crc_ = Crc32(crc_, prefix.data(), prefix.size());
+  crc_ = Crc32(prefix, sizeof(prefix), crc_);
   return Status::Ok();
 }
 
@@ -266,24 +314,25 @@ Status Scanner::Run() {
     return Status::DataLoss("bag '" + path_ + "': not an MCAP file (no magic)");
   }
   out_->path = path_;
-  crc_ = Crc32(0, magic.data(), magic.size());
+  crc_ = Crc32(magic.data(), magic.size());
   uint64_t offset = kMcapMagicBytes;
-  std::vector<uint8_t> content;
   for (bool first = true;; first = false) {
     if (offset == size_) {
       return Damage(offset, 0, "unfinished: the file ends without DataEnd record and footer");
     }
     uint8_t op = 0;
     const uint32_t crc_before = crc_;
-    const Status read = ReadRecordAt(offset, &op, &content);
+    const Status read = ReadRecordAt(offset, &op);
     if (read.code() == Status::Code::kIoError) return read;
     if (!read.ok() || (first && op != kMcapHeader)) {
       const std::string what = read.ok() ? "first record is not a Header" : read.message();
       if (first) return Status::DataLoss("bag '" + path_ + "': " + what);
       return Damage(offset, size_ - offset, what);
     }
+    const uint8_t* content = content_.data();
+    const uint64_t length = content_.size();
     if (op == kMcapDataEnd || op == kMcapFooter) {
-      RosMessageReader reader(content.data(), content.size());
+      RosMessageReader reader(content, length);
       uint32_t data_crc = 0;
       if (op == kMcapDataEnd && reader.ReadU32("data_section_crc", &data_crc).ok() &&
           data_crc != 0 && data_crc != crc_before && !out_->damage.recovered) {
@@ -291,17 +340,19 @@ Status Scanner::Run() {
       }
       return Status::Ok();
     }
-    crc_ = Crc32(crc_, content.data(), content.size());
-    if (op == kMcapHeader) {
-      RosMessageReader reader(content.data(), content.size());
-      static_cast<void>(reader.ReadString("profile", &out_->profile));
-    } else if (op == kMcapChunk) {
-      SWARMLIO_RETURN_IF_ERROR(OnChunk(content, offset));
+    if (op == kMcapChunk) {
+      SWARMLIO_RETURN_IF_ERROR(OnChunk(offset));  // adds the chunk to crc_
     } else {
-      SWARMLIO_RETURN_IF_ERROR(OnRecord(op, content.data(), content.size(),
-                                        offset + kMcapRecordPrefixBytes, -1, offset));
+      crc_ = Crc32(content, length, crc_);
+      if (op == kMcapHeader) {
+        RosMessageReader reader(content, length);
+        static_cast<void>(reader.ReadString("profile", &out_->profile));
+      } else {
+        SWARMLIO_RETURN_IF_ERROR(
+            OnRecord(op, content, length, offset + kMcapRecordPrefixBytes, -1, offset));
+      }
     }
-    offset += kMcapRecordPrefixBytes + content.size();
+    offset += kMcapRecordPrefixBytes + length;
   }
 }
 
@@ -315,38 +366,80 @@ Status ScanMcapFile(const std::string& path, bool recover, McapFile* file) {
   return Status::Ok();
 }
 
-McapMessageReader::McapMessageReader(const McapFile* file) : file_(file) {}
+McapChunkCache::McapChunkCache(const McapFile* file) : file_(file) {}
 
-Status McapMessageReader::Read(const McapMessage& message, const uint8_t** data) {
+BagFile* McapChunkCache::File() {
   if (reader_ == nullptr) {
     std::error_code ec;
     const uint64_t size = std::filesystem::file_size(file_->path, ec);
     reader_ = std::make_unique<BagFile>(file_->path, ec ? 0 : size);
   }
-  const std::string where =
-      "bag '" + file_->path + "': message at offset " + std::to_string(message.offset);
+  return reader_.get();
+}
+
+Status McapChunkCache::Read(uint64_t offset, uint64_t size, ByteBuffer* bytes) {
+  if (!File()->Read(offset, static_cast<size_t>(size), bytes->Resize(static_cast<size_t>(size)))) {
+    return Status::IoError("read failed (file changed?)");
+  }
+  return Status::Ok();
+}
+
+Status McapChunkCache::Get(int64_t chunk, std::shared_ptr<const McapCachedChunk>* records) {
+  for (size_t i = 0; i < kept_.size(); ++i) {
+    if (kept_[i]->chunk != chunk) continue;
+    std::rotate(kept_.begin(), kept_.begin() + static_cast<std::ptrdiff_t>(i),
+                kept_.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+    *records = kept_.front();
+    return Status::Ok();
+  }
+  // The least recently used chunk makes room; its buffers are reused unless
+  // a stream still holds it.
+  std::shared_ptr<McapCachedChunk> entry;
+  if (kept_.size() >= kKeptMcapChunks) {
+    entry = std::move(kept_.back());
+    kept_.pop_back();
+    if (entry.use_count() > 1) entry.reset();
+  }
+  if (entry == nullptr) entry = std::make_shared<McapCachedChunk>();
+  const McapChunk& c = file_->chunks[static_cast<size_t>(chunk)];
+  const size_t stored_bytes = static_cast<size_t>(c.records_bytes);
+  entry->chunk = -1;
+  uint8_t* stored = entry->stored.Resize(stored_bytes);
+  if (!File()->Read(c.records_offset, stored_bytes, stored)) {
+    return Status::IoError("chunk read failed (file changed?)");
+  }
+  SWARMLIO_RETURN_IF_ERROR(McapChunkRecords(c.compression, stored, stored_bytes,
+                                            c.uncompressed_bytes, &entry->decompressed,
+                                            &entry->data));
+  entry->size = c.uncompressed_bytes;
+  entry->chunk = chunk;
+  kept_.insert(kept_.begin(), entry);
+  *records = std::move(entry);
+  return Status::Ok();
+}
+
+McapMessageReader::McapMessageReader(const McapFile* file, McapChunkCache* cache)
+    : file_(file), cache_(cache) {}
+
+Status McapMessageReader::Read(const McapMessage& message, const uint8_t** data) {
+  const auto where = [&] {
+    return "bag '" + file_->path + "': message at offset " + std::to_string(message.offset);
+  };
   if (message.chunk < 0) {
-    if (!reader_->Read(message.offset, static_cast<size_t>(message.size), &stored_)) {
-      return Status::IoError(where + ": read failed (file changed?)");
-    }
+    const Status status = cache_->Read(message.offset, message.size, &stored_);
+    if (!status.ok()) return status.WithContext(where());
     *data = stored_.data();
     return Status::Ok();
   }
-  const McapChunk& chunk = file_->chunks[static_cast<size_t>(message.chunk)];
-  if (cached_chunk_ != message.chunk) {
-    cached_chunk_ = -1;
-    if (!reader_->Read(chunk.records_offset, static_cast<size_t>(chunk.records_bytes), &stored_)) {
-      return Status::IoError(where + ": chunk read failed (file changed?)");
-    }
-    SWARMLIO_RETURN_IF_ERROR(DecompressMcapChunk(chunk.compression, stored_.data(), stored_.size(),
-                                                 chunk.uncompressed_bytes, &chunk_)
-                                 .WithContext(where));
-    cached_chunk_ = message.chunk;
+  if (chunk_ == nullptr || chunk_->chunk != message.chunk) {
+    chunk_.reset();  // so that the cache may reuse its buffers
+    const Status status = cache_->Get(message.chunk, &chunk_);
+    if (!status.ok()) return status.WithContext(where());
   }
-  if (message.offset > chunk_.size() || message.size > chunk_.size() - message.offset) {
-    return Status::DataLoss(where + ": outside its chunk");
+  if (message.offset > chunk_->size || message.size > chunk_->size - message.offset) {
+    return Status::DataLoss(where() + ": outside its chunk");
   }
-  *data = chunk_.data() + message.offset;
+  *data = chunk_->data + message.offset;
   return Status::Ok();
 }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "src/io/bag_records.h"
+#include "src/io/byte_buffer.h"
 #include "swarmlio/common/status.h"
 #include "swarmlio/io/read_stats.h"
 
@@ -63,22 +64,55 @@ struct McapFile {
 /// the file cannot be opened; DataLoss when it is not MCAP.
 Status ScanMcapFile(const std::string& path, bool recover, McapFile* file);
 
-/// Reads message bytes of a scanned file, keeping the last decompressed
-/// chunk (the messages of one topic are read in nearly file order).
+/// The records of one chunk as read by McapChunkCache.
+struct McapCachedChunk {
+  int64_t chunk = -1;             // index into McapFile::chunks; -1 while being read
+  const uint8_t* data = nullptr;  // the records: in `stored` if uncompressed, else `decompressed`
+  uint64_t size = 0;
+  ByteBuffer stored;
+  ByteBuffer decompressed;
+};
+
+/// The chunks of a scanned file, each read from the file (and decompressed)
+/// once for all the topic streams over it: they move through the file
+/// together (the reader merges them by time), so the last few chunks are
+/// kept. Not thread-safe: the streams of one source are read by one thread.
+class McapChunkCache {
+ public:
+  /// `file` must outlive the cache.
+  explicit McapChunkCache(const McapFile* file);
+
+  /// Points *records at chunk `chunk`'s records (checked as by
+  /// McapChunkRecords), which stay valid while *records is held. IoError if
+  /// the file is shorter than at the scan.
+  Status Get(int64_t chunk, std::shared_ptr<const McapCachedChunk>* records);
+
+  /// Reads `size` bytes at file offset `offset` (an unchunked message).
+  Status Read(uint64_t offset, uint64_t size, ByteBuffer* bytes);
+
+ private:
+  BagFile* File();  // opened at the first read
+
+  const McapFile* file_;
+  std::unique_ptr<BagFile> reader_;
+  std::vector<std::shared_ptr<McapCachedChunk>> kept_;  // most recently used first
+};
+
+/// Reads message bytes of a scanned file for one topic stream: chunked
+/// messages from the shared McapChunkCache, unchunked ones from the file.
 class McapMessageReader {
  public:
-  /// `file` must outlive the reader.
-  explicit McapMessageReader(const McapFile* file);
+  /// `file` and `cache` must outlive the reader.
+  McapMessageReader(const McapFile* file, McapChunkCache* cache);
 
   /// Points *data at the message's bytes, valid until the next call.
   Status Read(const McapMessage& message, const uint8_t** data);
 
  private:
   const McapFile* file_;
-  std::unique_ptr<BagFile> reader_;
-  int64_t cached_chunk_ = -1;
-  std::vector<uint8_t> stored_;
-  std::vector<uint8_t> chunk_;
+  McapChunkCache* cache_;
+  std::shared_ptr<const McapCachedChunk> chunk_;  // the last chunked message's
+  ByteBuffer stored_;                             // the last unchunked message
 };
 
 }  // namespace swarmlio::io::internal

@@ -15,8 +15,8 @@ namespace {
 
 class McapTopicStream : public TopicMessageStream {
  public:
-  McapTopicStream(const McapFile* file, std::vector<size_t> messages)
-      : file_(file), messages_(std::move(messages)), reader_(file) {}
+  McapTopicStream(const McapFile* file, McapChunkCache* cache, std::vector<size_t> messages)
+      : file_(file), messages_(std::move(messages)), reader_(file, cache) {}
 
   Status Next(uint64_t max_bytes, SourceMessage* message, bool* has_message) override {
     *has_message = false;
@@ -86,12 +86,13 @@ class McapSource : public BagSource {
   }
 
   Status OpenTopic(const std::string& topic, std::unique_ptr<TopicMessageStream>* stream) override {
-    *stream = std::make_unique<McapTopicStream>(&file_, index_.Messages(topic));
+    *stream = std::make_unique<McapTopicStream>(&file_, &cache_, index_.Messages(topic));
     return Status::Ok();
   }
 
  private:
   McapFile file_;
+  McapChunkCache cache_{&file_};  // shared by the topic streams
   std::vector<SourceConnection> connections_;
   internal::TopicIndex index_;
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "src/io/crc32.h"
 #include "src/io/mcap_compression.h"
 #include "src/io/mcap_format.h"
 
@@ -43,7 +44,7 @@ Status McapWriter::Open(const std::string& path, const McapWriterOptions& option
   open_ = true;
   file_.write(reinterpret_cast<const char*>(kMcapMagic), kMcapMagicBytes);
   offset_ = kMcapMagicBytes;
-  data_crc_ = Crc32(0, kMcapMagic, kMcapMagicBytes);
+  data_crc_ = Crc32(kMcapMagic, kMcapMagicBytes);
   std::vector<uint8_t> header;
   PutString(&header, options_.profile);
   PutString(&header, "swarmlio");
@@ -58,7 +59,7 @@ Status McapWriter::WriteRecord(uint8_t op, const std::vector<uint8_t>& content, 
               static_cast<std::streamsize>(bytes.size()));
   if (!file_.good()) return Status::IoError("bag '" + path_ + "': write failed");
   offset_ += bytes.size();
-  if (data_section) data_crc_ = Crc32(data_crc_, bytes.data(), bytes.size());
+  if (data_section) data_crc_ = Crc32(bytes.data(), bytes.size(), data_crc_);
   return Status::Ok();
 }
 
@@ -131,7 +132,7 @@ Status McapWriter::FlushChunk() {
   PutLe<uint64_t>(&chunk, chunk_start_ns_);
   PutLe<uint64_t>(&chunk, chunk_end_ns_);
   PutLe<uint64_t>(&chunk, chunk_records_.size());
-  PutLe<uint32_t>(&chunk, Crc32(0, chunk_records_.data(), chunk_records_.size()));
+  PutLe<uint32_t>(&chunk, Crc32(chunk_records_.data(), chunk_records_.size()));
   PutString(&chunk, options_.compression);
   PutLe<uint64_t>(&chunk, stored.size());
   chunk.insert(chunk.end(), stored.begin(), stored.end());
@@ -203,7 +204,7 @@ Status McapWriter::Close() {
   PutLe<uint64_t>(&summary, 20);
   PutLe<uint64_t>(&summary, summary_start);
   PutLe<uint64_t>(&summary, 0);
-  PutLe<uint32_t>(&summary, Crc32(0, summary.data(), summary.size()));
+  PutLe<uint32_t>(&summary, Crc32(summary.data(), summary.size()));
   summary.insert(summary.end(), kMcapMagic, kMcapMagic + kMcapMagicBytes);
   file_.write(reinterpret_cast<const char*>(summary.data()),
               static_cast<std::streamsize>(summary.size()));

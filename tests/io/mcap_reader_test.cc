@@ -227,6 +227,54 @@ TEST(McapReaderTest, ChunkWithABadCrcIsSkippedAndCounted) {
   EXPECT_TRUE(Contains(status.message(), dir.File("bad_crc.mcap"))) << status.message();
 }
 
+// One byte changed inside an uncompressed chunk's records (the reader finds
+// messages in place there): the chunk's CRC catches it, and a chunk without
+// one (CRC 0) is caught by DataEnd's data-section CRC, which the reader
+// combines from the chunk header's CRC and the records'.
+TEST(McapReaderTest, ChangedByteInAnUncompressedChunkIsCaughtByACrc) {
+  TempDir dir;
+  for (bool chunk_crc : {true, false}) {
+    McapBuilder builder;
+    for (const auto& [op, content] : Definitions()) builder.Add(op, content);
+    size_t second_end = 0;
+    for (int c = 0; c < 3; ++c) {
+      std::vector<std::pair<uint8_t, Bytes>> records;
+      for (int i = 30 * c; i < 30 * (c + 1); ++i) {
+        for (auto& r : Messages(i)) records.push_back(std::move(r));
+      }
+      const size_t end = builder.AddChunk(records, "", chunk_crc);
+      if (c == 1) second_end = end;
+    }
+    Bytes bytes = builder.Finish();
+    WriteFile(dir.File("clean.mcap"), bytes);
+    std::vector<BagRecord> records;
+    ReadStats stats;
+    ASSERT_TRUE(ReadAll(dir.File("clean.mcap"), BagReaderOptions(), &records, &stats).ok());
+    EXPECT_EQ(Select<ImuSample>(records).size(), 90u);
+    EXPECT_FALSE(stats.recovery.recovered) << stats.recovery.reason;
+
+    // The last byte of the second chunk: in IMU sample 59's covariance.
+    bytes[second_end - 1] ^= 0x01;
+    const std::string corrupt = dir.File("changed.mcap");
+    WriteFile(corrupt, bytes);
+    stats = ReadStats();
+    ASSERT_TRUE(ReadAll(corrupt, BagReaderOptions(), &records, &stats).ok());
+    EXPECT_TRUE(stats.recovery.recovered);
+    if (chunk_crc) {
+      EXPECT_EQ(Select<ImuSample>(records).size(), 60u);  // the chunk is skipped
+      EXPECT_TRUE(Contains(stats.recovery.reason, "uncompressed CRC")) << stats.recovery.reason;
+    } else {
+      EXPECT_EQ(Select<ImuSample>(records).size(), 90u);  // found only at DataEnd
+      EXPECT_TRUE(Contains(stats.recovery.reason, "data section CRC")) << stats.recovery.reason;
+    }
+    BagReaderOptions strict;
+    strict.recover_damaged_bags = false;
+    const Status status = ReadAll(corrupt, strict, &records);
+    EXPECT_EQ(status.code(), Status::Code::kDataLoss);
+    EXPECT_TRUE(Contains(status.message(), "CRC")) << status.message();
+  }
+}
+
 // Cut at many places: unchunked messages count when their record is whole,
 // chunked ones when their chunk is.
 TEST(McapReaderTest, TruncatedMcapYieldsEveryCompleteRecordBeforeTheCut) {

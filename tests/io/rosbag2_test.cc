@@ -57,7 +57,8 @@ void McapToDb3(const std::string& mcap,
       sqlite3_prepare_v2(db, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?,?,?)", -1,
                          &insert, nullptr),
       SQLITE_OK);
-  internal::McapMessageReader reader(&file);
+  internal::McapChunkCache cache(&file);
+  internal::McapMessageReader reader(&file, &cache);
   Exec(db, "BEGIN");
   for (size_t i = begin; i < std::min(end, file.messages.size()); ++i) {
     const internal::McapMessage& m = file.messages[i];
