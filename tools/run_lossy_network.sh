@@ -10,6 +10,9 @@
 #   SEEDS="$(seq -s ' ' 1 16)" SCENARIO_SEEDS="2 102 202" OUT=results/ideal \
 #     tools/run_lossy_network.sh wall_degenerate    # held-out scenario seeds too
 #
+#   tools/run_lossy_network.sh --from_sweep OUT     # only the table, from a finished
+#                                                   # `tools/sweep.sh local configs/sweeps/lossy_network.yaml OUT`
+#
 # SCENARIO_SEEDS (default: the file's seed) lists scenario seeds; one without a run in
 # OUT/<name>/seed<S>/ is simulated here (swarmlio_sim --seed S --imperfections
 # $IMPERFECTIONS, default realistic) and replayed lossless first.
@@ -31,6 +34,37 @@ ape() {  # ape <metrics.csv> <drone>: the SE(3)-aligned APE RMSE [m]
   awk -F, -v d="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "ape_rmse_m") c = i }
                      NR > 1 && $1 == d { printf "%.4f", $c }' "$1"
 }
+
+# row <scenario> <scenario seed> <lossless metrics.csv> <lossy metrics.csv>...: one row per drone.
+row() {
+  local name="$1" scenario_seed="$2" base_csv="$3"; shift 3
+  for drone in $(awk -F, 'NR > 1 { print $1 }' "$base_csv"); do
+    base=$(ape "$base_csv" "$drone")
+    values=() worst=0
+    for csv in "$@"; do
+      v=$(ape "$csv" "$drone")
+      values+=("${v:-n/a}")
+      worst=$(awk -v a="$v" -v b="$base" -v w="$worst" 'BEGIN { c = (a - b) / b * 100; print (c > w ? c : w) }')
+    done
+    joined=$(IFS=/; echo "${values[*]}")
+    printf '| %s | %s | %s | %s | %s | %+.0f %% |\n' "$name" "$scenario_seed" "$drone" "$base" \
+        "${joined//\// \/ }" "$worst"
+  done
+}
+
+if [[ "${1:-}" == "--from_sweep" ]]; then
+  out="${2:?--from_sweep needs the output folder of the sweep}"
+  echo "| scenario | scenario seed | drone | lossless | network seeds ${SEEDS// / \/ } | worst change |"
+  echo "|---|---:|---|---:|---|---:|"
+  for base_csv in "$out"/runs/lossless/*/seed*/swarm/metrics.csv; do
+    seed_dir="$(dirname "$(dirname "$base_csv")")"
+    name="$(basename "$(dirname "$seed_dir")")" scenario_seed="$(basename "$seed_dir")"
+    lossy=()
+    for seed in $SEEDS; do lossy+=("$out/runs/lossy_seed$seed/$name/$scenario_seed/swarm/metrics.csv"); done
+    row "$name" "${scenario_seed#seed}" "$base_csv" "${lossy[@]}"
+  done
+  exit 0
+fi
 
 echo "| scenario | scenario seed | drone | lossless | network seeds ${SEEDS// / \/ } | worst change |"
 echo "|---|---:|---|---:|---|---:|"
@@ -56,17 +90,8 @@ for name in "${scenarios[@]}"; do
         --output_dir "$dir/lossy_seed$seed" --save_maps=false > "$dir/lossy_seed$seed.log" 2>&1 ||
         echo "replay failed: $dir/lossy_seed$seed.log" >&2
     done
-    for drone in $(awk -F, 'NR > 1 { print $1 }' "$dir/swarm/metrics.csv"); do
-      base=$(ape "$dir/swarm/metrics.csv" "$drone")
-      values=() worst=0
-      for seed in $SEEDS; do
-        v=$(ape "$dir/lossy_seed$seed/metrics.csv" "$drone")
-        values+=("${v:-n/a}")
-        worst=$(awk -v a="$v" -v b="$base" -v w="$worst" 'BEGIN { c = (a - b) / b * 100; print (c > w ? c : w) }')
-      done
-      joined=$(IFS=/; echo "${values[*]}")
-      printf '| %s | %s | %s | %s | %s | %+.0f %% |\n' "$name" "$scenario_seed" "$drone" "$base" \
-          "${joined//\// \/ }" "$worst"
-    done
+    lossy=()
+    for seed in $SEEDS; do lossy+=("$dir/lossy_seed$seed/metrics.csv"); done
+    row "$name" "$scenario_seed" "$dir/swarm/metrics.csv" "${lossy[@]}"
   done
 done
