@@ -15,7 +15,9 @@
 // part) is repeated for a point only when its position in G moved more than
 // research_distance_m since its last search (FAST-LIO searches at the first
 // iteration and after convergence only). With research_distance_m = 0 every
-// iteration searches every point.
+// iteration searches every point. The searches and plane fits may run on
+// several threads (ParallelFor); the gate, the counts and the list are made
+// after them in point order, so the result does not depend on the threads.
 #pragma once
 
 #include <Eigen/Core>
