@@ -88,6 +88,37 @@ void LoadScenarioWithSeed(const std::string& name, int seed, sim::Scenario* scen
   ASSERT_EQ(scenario->imperfections, sim::ImperfectionPreset::kRealistic);
 }
 
+// What one drone's run through a fresh odometry gave.
+struct OdometryRun {
+  std::vector<lio::ScanOutput> scans;  // every scan, the queue flushed at the end
+  std::vector<PoseStamped> ground_truth;
+  lio::OdometryCounters counters;
+  bool initialized = false;
+};
+
+// Runs drone `index` of `simulator` through a new odometry with `options`.
+void RunOdometry(sim::Simulator* simulator, int index, const lio::OdometryOptions& options,
+                 const LidarOptions& lidar, OdometryRun* run) {
+  std::unique_ptr<lio::Odometry> odometry;
+  ASSERT_TRUE(lio::Odometry::Create(options, lidar, &odometry).ok());
+  OdometrySink sink(odometry.get());
+  sim::DroneStats stats;
+  ASSERT_TRUE(simulator->RunDrone(index, &sink, &stats).ok());
+  ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
+  run->scans = std::move(sink.scans);
+  run->ground_truth = std::move(sink.ground_truth);
+  run->counters = odometry->counters();
+  run->initialized = odometry->initialized();
+}
+
+// Position and rotation errors of a run's updated scans against its ground truth.
+void Evaluate(const OdometryRun& run, eval::ConsistencyStats* consistency) {
+  ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(run.scans),
+                                        eval::TrajectoryFromPoses(run.ground_truth), 0.05,
+                                        consistency)
+                  .ok());
+}
+
 // Runs drone `index` of `simulator` through the odometry with the calibration
 // the simulator hands over (with its error, not the truth).
 void RunWithGivenCalibration(sim::Simulator* simulator,
@@ -95,16 +126,9 @@ void RunWithGivenCalibration(sim::Simulator* simulator,
                              int index,
                              eval::ConsistencyStats* consistency) {
   const driver::DroneInput given = swarmlio::testing::GivenDroneInput(d);
-  std::unique_ptr<lio::Odometry> odometry;
-  ASSERT_TRUE(lio::Odometry::Create(given.odometry, given.lidar, &odometry).ok());
-  OdometrySink sink(odometry.get());
-  sim::DroneStats stats;
-  ASSERT_TRUE(simulator->RunDrone(index, &sink, &stats).ok());
-  ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
-  ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(sink.scans),
-                                        eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
-                                        consistency)
-                  .ok());
+  OdometryRun run;
+  ASSERT_NO_FATAL_FAILURE(RunOdometry(simulator, index, given.odometry, given.lidar, &run));
+  Evaluate(run, consistency);
 }
 
 TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
@@ -130,26 +154,18 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
     const sim::DroneConfig& d = drones[c.drone];
     SCOPED_TRACE(d.name);
     const driver::DroneInput given = swarmlio::testing::GivenDroneInput(d);
-    std::unique_ptr<lio::Odometry> odometry;
-    ASSERT_TRUE(lio::Odometry::Create(given.odometry, given.lidar, &odometry).ok());
-    OdometrySink sink(odometry.get());
-    sim::DroneStats stats;
-    ASSERT_TRUE(simulator.RunDrone(c.drone, &sink, &stats).ok());
-    ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
-
-    ASSERT_TRUE(odometry->initialized());
-    ASSERT_GE(sink.scans.size(), 80u);
+    OdometryRun run;
+    ASSERT_NO_FATAL_FAILURE(RunOdometry(&simulator, c.drone, given.odometry, given.lidar, &run));
+    ASSERT_TRUE(run.initialized);
+    ASSERT_GE(run.scans.size(), 80u);
     int updated = 0;
-    for (const auto& s : sink.scans) {
+    for (const auto& s : run.scans) {
       ASSERT_TRUE(s.state.p_b_in_G.allFinite() && (s.covariance.topLeftCorner<6, 6>().allFinite()));
       updated += s.updated ? 1 : 0;
     }
-    EXPECT_GE(updated, static_cast<int>(sink.scans.size()) - 1);  // all but the map's first
+    EXPECT_GE(updated, static_cast<int>(run.scans.size()) - 1);  // all but the map's first
     eval::ConsistencyStats consistency;
-    ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(sink.scans),
-                                          eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
-                                          &consistency)
-                    .ok());
+    ASSERT_NO_FATAL_FAILURE(Evaluate(run, &consistency));
     std::printf("[ figures  ] %s: %d poses, position RMSE %.4f m, rotation RMSE %.3f deg, "
                 "mean position NEES %.2f\n",
                 d.name.c_str(), consistency.num_poses, consistency.position_rmse_m,
@@ -182,13 +198,9 @@ TEST(OdometryEndToEnd, SameEstimateForAnyThreadCount) {
   for (const int threads : {1, 2, 3}) {
     lio::OdometryOptions options = given.odometry;
     options.threads = threads;
-    std::unique_ptr<lio::Odometry> odometry;
-    ASSERT_TRUE(lio::Odometry::Create(options, given.lidar, &odometry).ok());
-    OdometrySink sink(odometry.get());
-    sim::DroneStats stats;
-    ASSERT_TRUE(simulator.RunDrone(0, &sink, &stats).ok());
-    ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
-    runs.push_back(std::move(sink.scans));
+    OdometryRun run;
+    ASSERT_NO_FATAL_FAILURE(RunOdometry(&simulator, 0, options, given.lidar, &run));
+    runs.push_back(std::move(run.scans));
   }
   ASSERT_GT(runs[0].size(), 40u);
   int updated = 0;
@@ -235,18 +247,11 @@ TEST(OdometryEndToEnd, StaticStartScansSeedTheMap) {
     const driver::DroneInput given = swarmlio::testing::GivenDroneInput(d);  // the truth here
     lio::OdometryOptions options = given.odometry;
     options.seed_map_from_static_start = seed;
-    std::unique_ptr<lio::Odometry> odometry;
-    ASSERT_TRUE(lio::Odometry::Create(options, given.lidar, &odometry).ok());
-    OdometrySink sink(odometry.get());
-    sim::DroneStats stats;
-    ASSERT_TRUE(simulator.RunDrone(2, &sink, &stats).ok());
-    ASSERT_TRUE(sink.Collect(/*flush=*/true).ok());
-    const lio::OdometryCounters& c = odometry->counters();
+    OdometryRun run;
+    ASSERT_NO_FATAL_FAILURE(RunOdometry(&simulator, 2, options, given.lidar, &run));
+    const lio::OdometryCounters& c = run.counters;
     eval::ConsistencyStats consistency;
-    ASSERT_TRUE(eval::EvaluateConsistency(replay::UpdatedEstimate(sink.scans),
-                                          eval::TrajectoryFromPoses(sink.ground_truth), 0.05,
-                                          &consistency)
-                    .ok());
+    ASSERT_NO_FATAL_FAILURE(Evaluate(run, &consistency));
     std::printf("[ figures  ] %s: %lld scans seeded the map, rotation RMSE %.3f deg\n",
                 seed ? "seeded" : "not seeded", static_cast<long long>(c.scans_seeding_map),
                 consistency.rotation_rmse_deg);
