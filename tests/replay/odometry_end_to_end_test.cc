@@ -131,17 +131,29 @@ void RunWithGivenCalibration(sim::Simulator* simulator,
   Evaluate(run, consistency);
 }
 
-TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
+// A simulator of indoor_3uav (with `overrides`) for its first `duration_s`,
+// one thread, and the scenario's drones.
+void MakeIndoorSimulator(double duration_s, const sim::ScenarioOverrides& overrides,
+                         std::unique_ptr<sim::Simulator>* simulator,
+                         std::vector<sim::DroneConfig>* drones) {
   sim::Scenario scenario;
   ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
                                     "/configs/scenarios/indoor_3uav.yaml",
-                                &scenario)
+                                &scenario, overrides)
                   .ok());
   sim::SimulationConfig config = scenario.simulation_config();
-  config.duration_s = 10.0;  // 4 s static, take-off, 4 s of excitation
+  config.duration_s = duration_s;
   config.num_threads = 1;
-  const std::vector<sim::DroneConfig> drones = scenario.drones;
-  sim::Simulator simulator(std::move(scenario.scene), drones, scenario.objects, config);
+  *drones = scenario.drones;
+  *simulator = std::make_unique<sim::Simulator>(std::move(scenario.scene), *drones,
+                                                scenario.objects, config);
+}
+
+TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
+  std::unique_ptr<sim::Simulator> simulator;
+  std::vector<sim::DroneConfig> drones;
+  // 4 s static, take-off, 4 s of excitation.
+  ASSERT_NO_FATAL_FAILURE(MakeIndoorSimulator(10.0, {}, &simulator, &drones));
 
   // uav1: Mid-360 (m/s^2 IMU); uav3: Avia (IMU in g, 2 ms stamp offset).
   // Measured (Release, the given calibration): position RMSE 0.0026 and
@@ -155,7 +167,8 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
     SCOPED_TRACE(d.name);
     const driver::DroneInput given = swarmlio::testing::GivenDroneInput(d);
     OdometryRun run;
-    ASSERT_NO_FATAL_FAILURE(RunOdometry(&simulator, c.drone, given.odometry, given.lidar, &run));
+    ASSERT_NO_FATAL_FAILURE(
+        RunOdometry(simulator.get(), c.drone, given.odometry, given.lidar, &run));
     ASSERT_TRUE(run.initialized);
     ASSERT_GE(run.scans.size(), 80u);
     int updated = 0;
@@ -183,23 +196,17 @@ TEST(OdometryEndToEnd, TracksAShortIndoorFlight) {
 // and correspondence counts on a realistic take-off (a reduction or a shared
 // scratch buffer across threads would break the equality).
 TEST(OdometryEndToEnd, SameEstimateForAnyThreadCount) {
-  sim::Scenario scenario;
-  ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
-                                    "/configs/scenarios/indoor_3uav.yaml",
-                                &scenario)
-                  .ok());
-  sim::SimulationConfig config = scenario.simulation_config();
-  config.duration_s = 6.0;  // the 4 s static start and 2 s of take-off
-  config.num_threads = 1;
-  const std::vector<sim::DroneConfig> drones = scenario.drones;
-  sim::Simulator simulator(std::move(scenario.scene), drones, scenario.objects, config);
+  std::unique_ptr<sim::Simulator> simulator;
+  std::vector<sim::DroneConfig> drones;
+  // The 4 s static start and 2 s of take-off.
+  ASSERT_NO_FATAL_FAILURE(MakeIndoorSimulator(6.0, {}, &simulator, &drones));
   const driver::DroneInput given = swarmlio::testing::GivenDroneInput(drones[0]);  // Mid-360
   std::vector<std::vector<lio::ScanOutput>> runs;
   for (const int threads : {1, 2, 3}) {
     lio::OdometryOptions options = given.odometry;
     options.threads = threads;
     OdometryRun run;
-    ASSERT_NO_FATAL_FAILURE(RunOdometry(&simulator, 0, options, given.lidar, &run));
+    ASSERT_NO_FATAL_FAILURE(RunOdometry(simulator.get(), 0, options, given.lidar, &run));
     runs.push_back(std::move(run.scans));
   }
   ASSERT_GT(runs[0].size(), 40u);
@@ -229,18 +236,12 @@ TEST(OdometryEndToEnd, SameEstimateForAnyThreadCount) {
 TEST(OdometryEndToEnd, StaticStartScansSeedTheMap) {
   // Ideal sensors: the realistic preset's LiDAR-IMU calibration error (a few
   // tenths of a degree) would dominate the rotation error this test bounds.
-  sim::Scenario scenario;
   sim::ScenarioOverrides ideal;
   ideal.imperfections = sim::ImperfectionPreset::kIdeal;
-  ASSERT_TRUE(sim::LoadScenario(std::string(SWARMLIO_SOURCE_DIR) +
-                                    "/configs/scenarios/indoor_3uav.yaml",
-                                &scenario, ideal)
-                  .ok());
-  sim::SimulationConfig config = scenario.simulation_config();
-  config.duration_s = 4.5;  // the 4 s static start and the first 0.5 s of the take-off
-  config.num_threads = 1;
-  const std::vector<sim::DroneConfig> drones = scenario.drones;
-  sim::Simulator simulator(std::move(scenario.scene), drones, scenario.objects, config);
+  std::unique_ptr<sim::Simulator> simulator;
+  std::vector<sim::DroneConfig> drones;
+  // The 4 s static start and the first 0.5 s of the take-off.
+  ASSERT_NO_FATAL_FAILURE(MakeIndoorSimulator(4.5, ideal, &simulator, &drones));
   const sim::DroneConfig& d = drones[2];  // uav3, Avia
   for (const bool seed : {true, false}) {
     SCOPED_TRACE(seed ? "seeded" : "not seeded");
@@ -248,7 +249,7 @@ TEST(OdometryEndToEnd, StaticStartScansSeedTheMap) {
     lio::OdometryOptions options = given.odometry;
     options.seed_map_from_static_start = seed;
     OdometryRun run;
-    ASSERT_NO_FATAL_FAILURE(RunOdometry(&simulator, 2, options, given.lidar, &run));
+    ASSERT_NO_FATAL_FAILURE(RunOdometry(simulator.get(), 2, options, given.lidar, &run));
     const lio::OdometryCounters& c = run.counters;
     eval::ConsistencyStats consistency;
     ASSERT_NO_FATAL_FAILURE(Evaluate(run, &consistency));
