@@ -16,24 +16,15 @@
 #include <cstdio>
 #include <ctime>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "swarmlio/common/split_list.h"
 #include "swarmlio/io/bag_reader.h"
 
 DEFINE_int32(repeats, 5, "passes over each set of files (the fastest is reported)");
 
 namespace {
-
-std::vector<std::string> Split(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
 
 // Reads every file of `files` once; false (printed) on an error.
 bool ReadOnce(const std::vector<std::string>& files, int64_t* records) {
@@ -68,7 +59,7 @@ int main(int argc, char** argv) {
       "| files | records | fastest pass [s] | records/s | fastest pass CPU [s] |\n"
       "|---|---|---|---|---|\n");
   for (int k = 1; k < argc; ++k) {
-    const std::vector<std::string> files = Split(argv[k]);
+    const std::vector<std::string> files = swarmlio::SplitList(argv[k]);
     double best_s = 1e300;
     double best_cpu_s = 1e300;
     int64_t records = 0;

@@ -13,12 +13,13 @@
 #include <gflags/gflags.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstdio>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "swarmlio/common/split_list.h"
 #include "swarmlio/driver/manifest.h"
 #include "swarmlio/eval/error_statistics.h"
 #include "swarmlio/replay/swarm_replay.h"
@@ -30,15 +31,6 @@ DEFINE_int32(repeats, 3, "passes per thread count (the fastest time per scan is 
 namespace {
 
 using swarmlio::Status;
-
-std::vector<int> ParseThreads(const std::string& list) {
-  std::vector<int> out;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');) {
-    if (!item.empty()) out.push_back(std::stoi(item));
-  }
-  return out;
-}
 
 // One stage's time of every updated scan of one drone [ms].
 struct Stage {
@@ -134,8 +126,15 @@ void KeepFastest(const Pass& pass, Pass* best) {
 int main(int argc, char** argv) {
   gflags::SetUsageMessage("bench_scan_time --manifest swarm.yaml [--threads 1,2] [--repeats 3]");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
-  const std::vector<int> threads = ParseThreads(FLAGS_threads);
-  if (FLAGS_manifest.empty() || threads.empty() || FLAGS_repeats < 1) {
+  std::vector<int> threads;
+  bool valid = true;
+  for (const std::string& item : swarmlio::SplitList(FLAGS_threads)) {
+    char* end = nullptr;
+    const long value = std::strtol(item.c_str(), &end, 10);
+    valid &= *end == '\0' && value >= 1 && value <= 256;
+    threads.push_back(static_cast<int>(value));
+  }
+  if (FLAGS_manifest.empty() || threads.empty() || !valid || FLAGS_repeats < 1) {
     std::fprintf(stderr, "usage: %s\n", gflags::ProgramUsage());
     return 2;
   }

@@ -2,10 +2,10 @@
 #include "live_flags.h"
 
 #include <exception>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "swarmlio/common/split_list.h"
 #include "swarmlio/net/swarm_key_file.h"
 
 DEFINE_string(manifest, "", "swarm manifest YAML (docs/replay.md); with --drone");
@@ -35,18 +35,9 @@ DEFINE_double(network_poll_period_ms, 2.0, "UDP poll period [ms]");
 namespace swarmlio::tools {
 namespace {
 
-std::vector<std::string> Split(const std::string& s, char separator) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, separator);) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
-
 Status ParsePeers(const std::string& text, const driver::SwarmManifest& manifest,
                   std::vector<net::UdpPeer>* peers) {
-  for (const std::string& item : Split(text, ',')) {
+  for (const std::string& item : SplitList(text)) {
     const size_t eq = item.find('=');
     const size_t colon = item.rfind(':');
     if (eq == std::string::npos || colon == std::string::npos || colon < eq) {

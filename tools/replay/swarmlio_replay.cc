@@ -27,6 +27,7 @@
 #include "progress_bar.h"
 #include "report.h"
 #include "swarm_report.h"
+#include "swarmlio/common/split_list.h"
 #include "swarmlio/config/config_file.h"
 #include "swarmlio/driver/manifest.h"
 #include "swarmlio/eval/consistency.h"
@@ -83,15 +84,6 @@ DEFINE_string(network_config, "",
 namespace swarmlio::tools {
 namespace {
 
-std::vector<std::string> Split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
-
 // The live process writes <name>_dropped_scans.txt next to
 // <name>_received.bin; a recording without it re-runs every scan.
 Status ReadDroppedScansNextTo(const std::string& name, const std::string& received_path,
@@ -114,7 +106,7 @@ Status ReadDroppedScansNextTo(const std::string& name, const std::string& receiv
 
 // --received_packets and --key_file into the replay options.
 Status ApplyReceivedPacketFlags(replay::ReplayOptions* options) {
-  for (const std::string& item : Split(FLAGS_received_packets)) {
+  for (const std::string& item : SplitList(FLAGS_received_packets)) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size()) {
       return Status::InvalidArgument("--received_packets: '" + item +
@@ -318,8 +310,8 @@ int Main() {
   }
   driver::SwarmManifest manifest;
   Status status = FLAGS_manifest.empty()
-                      ? driver::ManifestFromBags(Split(FLAGS_bags), FLAGS_sensor_preset,
-                                                 Split(FLAGS_names), &manifest)
+                      ? driver::ManifestFromBags(SplitList(FLAGS_bags), FLAGS_sensor_preset,
+                                                 SplitList(FLAGS_names), &manifest)
                       : driver::LoadManifest(FLAGS_manifest, &manifest);
   if (!status.ok()) {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());
