@@ -18,12 +18,23 @@
 
 namespace swarmlio::lio {
 
+namespace {
+
+// Threads for `threads` = 0: the machine's cores, at most this many.
+constexpr int kMaxDefaultThreads = 4;
+
+}  // namespace
+
 struct ParallelFor::Arena {
   explicit Arena(int threads) : arena(threads) {}
   mutable tbb::task_arena arena;
 };
 
-ParallelFor::ParallelFor(int threads) : threads_(threads > 0 ? threads : DefaultThreads()) {
+ParallelFor::ParallelFor(int threads) {
+  if (threads <= 0) {
+    const int hardware = static_cast<int>(std::thread::hardware_concurrency());
+    threads = std::max(1, std::min(hardware, kMaxDefaultThreads));
+  }
 #ifdef SWARMLIO_THREAD_SANITIZER
   // ThreadSanitizer cannot check TBB: Debian's libtbb is not instrumented,
   // so TSan misses its fork and join, and TBB's own header templates race
@@ -31,17 +42,12 @@ ParallelFor::ParallelFor(int threads) : threads_(threads > 0 ? threads : Default
   // Under TSan the loops run on the caller; their independence of the
   // thread count is checked in the Release build
   // (OdometryEndToEnd.SameEstimateForAnyThreadCount).
-  threads_ = 1;
+  threads = 1;
 #endif
-  if (threads_ > 1) arena_ = std::make_unique<Arena>(threads_);
+  if (threads > 1) arena_ = std::make_unique<Arena>(threads);
 }
 
 ParallelFor::~ParallelFor() = default;
-
-int ParallelFor::DefaultThreads() {
-  const int hardware = static_cast<int>(std::thread::hardware_concurrency());
-  return std::max(1, std::min(hardware, kMaxDefaultThreads));
-}
 
 void ParallelFor::Run(int64_t n, int64_t grain,
                       const std::function<void(int64_t, int64_t)>& body) const {

@@ -24,13 +24,15 @@ void ScanAssociator::SearchMoved(const Eigen::Matrix3d& R_G_b, const Eigen::Vect
   const std::vector<Eigen::Vector3d>& points = *points_in_b_;
   const double research_sq = options_.research_distance_m * options_.research_distance_m;
   searched_.assign(points.size(), 0);
-  // Each point reads the map and writes only its own cache entry and flag:
+  queries_in_G_.resize(points.size());
+  // Each point reads the map and writes only its own entries:
   // the same result for any thread count.
   const auto search = [&](int64_t begin, int64_t end) {
     std::vector<Neighbor> neighbors;
     neighbors.reserve(static_cast<size_t>(options_.num_neighbors));
     for (int64_t i = begin; i < end; ++i) {
-      const Eigen::Vector3d q_in_G = R_G_b * points[static_cast<size_t>(i)] + p_b_in_G;
+      Eigen::Vector3d& q_in_G = queries_in_G_[static_cast<size_t>(i)];
+      q_in_G = R_G_b * points[static_cast<size_t>(i)] + p_b_in_G;
       CachedPlane& cached = cache_[static_cast<size_t>(i)];
       if (research_sq != 0.0 && (q_in_G - cached.searched_at_in_G).squaredNorm() <= research_sq) {
         continue;
@@ -72,8 +74,7 @@ Status ScanAssociator::Associate(const SwarmState& x, std::vector<PlaneCorrespon
       ++stats_.num_no_plane;
       continue;
     }
-    const Eigen::Vector3d q_in_G = R_G_b * points[i] + p_b_in_G;
-    const double z = cached.plane.SignedDistance(q_in_G);
+    const double z = cached.plane.SignedDistance(queries_in_G_[i]);
     if (!(std::abs(z) < options_.residual_gate_factor * std::sqrt(points[i].norm()))) {
       ++stats_.num_gated;
       continue;

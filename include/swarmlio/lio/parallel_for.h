@@ -17,19 +17,11 @@ namespace swarmlio::lio {
 
 class ParallelFor {
  public:
-  /// Threads used by default: the machine's, capped.
-  static constexpr int kMaxDefaultThreads = 4;
-
-  /// `threads` >= 1, or 0 for DefaultThreads().
+  /// `threads` >= 1, or 0 for the machine's cores, at most 4.
   explicit ParallelFor(int threads);
   ~ParallelFor();
   ParallelFor(const ParallelFor&) = delete;
   ParallelFor& operator=(const ParallelFor&) = delete;
-
-  /// min(hardware concurrency, kMaxDefaultThreads), at least 1.
-  static int DefaultThreads();
-
-  int threads() const { return threads_; }
 
   /// Calls body(begin, end) for consecutive chunks of at most `grain`
   /// indices covering [0, n), possibly concurrently; returns when all ran.
@@ -37,8 +29,7 @@ class ParallelFor {
 
  private:
   struct Arena;
-  int threads_ = 1;
-  std::unique_ptr<Arena> arena_;  // null with one thread
+  std::unique_ptr<Arena> arena_;  // null with one thread: the body runs on the caller
 };
 
 }  // namespace swarmlio::lio

@@ -175,7 +175,8 @@ class ScanAssociator {
 
   // The neighbour search and plane fit of every point that moved more than
   // research_distance_m since its last search (all of them after Reset()),
-  // at the estimate (R_G_b, p_b_in_G); marks them in searched_.
+  // at the estimate (R_G_b, p_b_in_G); marks them in searched_ and leaves
+  // every point's position in G in queries_in_G_.
   void SearchMoved(const Eigen::Matrix3d& R_G_b, const Eigen::Vector3d& p_b_in_G);
 
   const LocalMap* map_;
@@ -184,6 +185,7 @@ class ScanAssociator {
   std::vector<CachedPlane> cache_;
   const ParallelFor* parallel_ = nullptr;
   std::vector<uint8_t> searched_;     // scratch: 1 where the last call searched
+  std::vector<Eigen::Vector3d> queries_in_G_;  // scratch: the points in G at the estimate
   std::vector<const Plane*> planes_;  // scratch: the plane of each correspondence
   std::vector<int> matched_;          // the scan point of each correspondence
   AssociationStats stats_;
