@@ -55,7 +55,8 @@ Status Odometry::Create(const OdometryOptions& options,
 Status Odometry::CreateBackEnd() {
   Impl& im = *impl_;
   if (options_.estimator == EstimatorKind::kWindow) {
-    return window::WindowBackEnd::Create(options_, &im.map, im.propagator.get(), &im.back_end);
+    return window::WindowBackEnd::Create(options_, &im.map, im.propagator.get(), &im.parallel,
+                                         &im.back_end);
   }
   im.back_end = std::make_unique<internal::FilterBackEnd>(options_, &im.map, im.propagator.get(),
                                                           &im.parallel);

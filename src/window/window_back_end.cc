@@ -19,11 +19,12 @@ WindowBackEnd::WindowBackEnd(const lio::OdometryOptions& options,
 Status WindowBackEnd::Create(const lio::OdometryOptions& options,
                              lio::LocalMap* map,
                              lio::ImuPropagator* propagator,
+                             const lio::ParallelFor* parallel,
                              std::unique_ptr<lio::internal::BackEnd>* back_end) {
   std::unique_ptr<WindowBackEnd> out(new WindowBackEnd(options, map, propagator));
   SWARMLIO_RETURN_IF_ERROR(WindowSmoother::Create(options.window, options.propagation,
                                                   options.association, options.update, map,
-                                                  &out->window_));
+                                                  &out->window_, parallel));
   *back_end = std::move(out);
   return Status::Ok();
 }

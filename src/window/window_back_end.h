@@ -14,16 +14,19 @@
 #include "swarmlio/lio/imu_propagator.h"
 #include "swarmlio/lio/local_map.h"
 #include "swarmlio/lio/odometry_options.h"
+#include "swarmlio/lio/parallel_for.h"
 
 namespace swarmlio::window {
 
 class WindowBackEnd final : public lio::internal::BackEnd {
  public:
-  /// InvalidArgument when the window options do not validate. `map` and
-  /// `propagator` must outlive the back end.
+  /// InvalidArgument when the window options do not validate. `map`,
+  /// `propagator` and `parallel` (may be null: one thread; the scans'
+  /// association) must outlive the back end.
   static Status Create(const lio::OdometryOptions& options,
                        lio::LocalMap* map,
                        lio::ImuPropagator* propagator,
+                       const lio::ParallelFor* parallel,
                        std::unique_ptr<lio::internal::BackEnd>* back_end);
 
   void StartInterval(int64_t stamp_ns,

@@ -17,7 +17,8 @@ Status WindowSmoother::Create(const lio::WindowOptions& options,
                               const lio::ScanAssociationOptions& association,
                               const lio::EsikfUpdateOptions& update,
                               const lio::LocalMap* map,
-                              std::unique_ptr<WindowSmoother>* smoother) {
+                              std::unique_ptr<WindowSmoother>* smoother,
+                              const lio::ParallelFor* parallel) {
   if (const std::string invalid = options.Validate(); !invalid.empty()) {
     return Status::InvalidArgument("window options: " + invalid);
   }
@@ -34,6 +35,7 @@ Status WindowSmoother::Create(const lio::WindowOptions& options,
   im.association = association;
   im.update = update;
   im.map = map;
+  im.parallel = parallel;
   SWARMLIO_RETURN_IF_ERROR(Marginalizer::Create(options.marginalization, &im.marginalizer));
   *smoother = std::move(out);
   return Status::Ok();
@@ -460,7 +462,7 @@ Status WindowSmoother::Impl::AddState(WindowStateInput* in,
   scan.points_in_b = std::move(input.points_in_b);
   scan.excluded = std::move(input.excluded);
   scan.use_planes = input.use_planes;
-  scan.associator = std::make_unique<lio::ScanAssociator>(im.map, im.association);
+  scan.associator = std::make_unique<lio::ScanAssociator>(im.map, im.association, im.parallel);
   const Status observations = im.TakeObservations(&input, &scan);
   if (!observations.ok()) *model_error = observations.message();
   while (static_cast<int>(im.scans.size()) > im.options.size) {

@@ -93,14 +93,16 @@ struct WindowCounters {
 
 class WindowSmoother {
  public:
-  /// InvalidArgument when the options do not validate. `map` must outlive
+  /// InvalidArgument when the options do not validate. `map` (and
+  /// `parallel`, the scans' association threads; null: one) must outlive
   /// the smoother; the odometry inserts the scans that leave.
   static Status Create(const lio::WindowOptions& options,
                        const lio::ImuPropagatorOptions& propagation,
                        const lio::ScanAssociationOptions& association,
                        const lio::EsikfUpdateOptions& update,
                        const lio::LocalMap* map,
-                       std::unique_ptr<WindowSmoother>* smoother);
+                       std::unique_ptr<WindowSmoother>* smoother,
+                       const lio::ParallelFor* parallel = nullptr);
   ~WindowSmoother();
 
   /// The IMU interval from the newest state to the next one, fed with

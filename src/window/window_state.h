@@ -94,6 +94,7 @@ struct WindowSmoother::Impl {
   lio::ScanAssociationOptions association;
   lio::EsikfUpdateOptions update;
   const lio::LocalMap* map = nullptr;
+  const lio::ParallelFor* parallel = nullptr;  // the scans' association (null: one thread)
   EgoStateManifold ego_manifold;
   GlobalExtrinsicManifold teammate_manifold;
   MarginalizationPriorFactorOptions prior_options;
