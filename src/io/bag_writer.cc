@@ -207,8 +207,9 @@ class BagWriter::Impl {
     return Status::Ok();
   }
 
+  // A ROS 2 log (MCAP or .db3): the message as CDR.
   template <class Msg>
-  Status WriteMcap(const std::string& topic,
+  Status WriteRos2(const std::string& topic,
                    internal::MessageKind kind,
                    int64_t record_time_ns,
                    const Msg& msg) {
@@ -217,13 +218,13 @@ class BagWriter::Impl {
                                      std::to_string(record_time_ns) + " ns is negative");
     }
     SWARMLIO_RETURN_IF_ERROR(CheckRos2Stamp(msg.header.stamp).WithContext("bag '" + path_ + "'"));
-    uint16_t channel = 0;
     internal::SerializeCdr(msg, &buffer_);
     if (db3_ != nullptr) {
       int64_t topic_id = 0;
       SWARMLIO_RETURN_IF_ERROR(Db3Topic(topic, kind, &topic_id));
       return db3_->WriteMessage(topic_id, record_time_ns, buffer_);
     }
+    uint16_t channel = 0;
     SWARMLIO_RETURN_IF_ERROR(McapChannel(topic, kind, &channel));
     return mcap_->WriteMessage(channel, static_cast<uint64_t>(record_time_ns), buffer_);
   }
@@ -234,7 +235,7 @@ class BagWriter::Impl {
                int64_t record_time_ns,
                const Msg& msg) {
     if (!open_) return Status::FailedPrecondition("bag '" + path_ + "': writer is closed");
-    if (mcap_ != nullptr || db3_ != nullptr) return WriteMcap(topic, kind, record_time_ns, msg);
+    if (mcap_ != nullptr || db3_ != nullptr) return WriteRos2(topic, kind, record_time_ns, msg);
     ros::Time time;
     SWARMLIO_RETURN_IF_ERROR(internal::BagTimeFromStampNs(record_time_ns, &time)
                                  .WithContext("bag '" + path_ + "': record time"));
